@@ -1,0 +1,25 @@
+//! Binary bounding volume hierarchies: the canonical tree, its builders and its node layouts.
+//!
+//! - [`Bvh2`]: the canonical tree, the single source of truth (node identity = index, pre-order).
+//! - [`SahBuilder`]: a binned SAH builder (needs `alloc`).
+//! - [`BinaryLayout`]: the Aila-Laine layout (both child boxes in the parent, leaf triangle arrays
+//!   closed by a termination marker) with uncle or parent/sibling links in the padding.
+//! - [`BvhMemory`]: the narrow read interface traversals use.
+
+mod memory;
+mod node;
+pub use memory::BvhMemory;
+pub use node::{BinaryNode, LeafWord, NodeRef};
+
+#[cfg(feature = "alloc")]
+mod layout;
+#[cfg(feature = "alloc")]
+mod sah;
+#[cfg(feature = "alloc")]
+mod tree;
+#[cfg(feature = "alloc")]
+pub use layout::{BinaryLayout, LinkKind};
+#[cfg(feature = "alloc")]
+pub use sah::{SahBuilder, SahConfig};
+#[cfg(feature = "alloc")]
+pub use tree::{Bvh2, Bvh2Node, NodeKind, TreeStats};

@@ -1,0 +1,234 @@
+use super::tree::{Bvh2, Bvh2Node, NodeKind};
+use crate::geometry::Triangle;
+use crate::{Aabb, Error};
+use alloc::vec::Vec;
+use glam::Vec3;
+
+/// Settings of the binned SAH builder.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SahConfig {
+    /// Bins per axis.
+    pub bins: usize,
+    /// Cost of one node traversal step, relative to `intersection_cost`.
+    pub traversal_cost: f32,
+    /// Cost of one ray/triangle test.
+    pub intersection_cost: f32,
+    /// Leaves larger than this are split even when the SAH prefers a leaf.
+    pub max_leaf_size: u32,
+    /// Depth cap (at most 63, so keys fit in 64 bits); nodes at the cap become leaves.
+    pub max_depth: u32,
+}
+
+impl Default for SahConfig {
+    fn default() -> Self {
+        Self { bins: 16, traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, max_depth: 63 }
+    }
+}
+
+/// A binned SAH builder (Wald 2007): centroids binned along each axis, the split with the least
+/// surface-area cost taken, a median split where binning cannot separate the primitives.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SahBuilder {
+    /// Settings.
+    pub config: SahConfig,
+}
+
+struct Work {
+    slot: usize,
+    start: usize,
+    end: usize,
+    depth: u32,
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    bounds: Aabb,
+    count: u32,
+}
+
+impl SahBuilder {
+    /// A builder with the given settings.
+    pub fn new(config: SahConfig) -> Self {
+        Self { config }
+    }
+
+    /// Builds the canonical tree over `triangles` (primitive id = index).
+    pub fn build(&self, triangles: &[Triangle]) -> Result<Bvh2, Error> {
+        if triangles.is_empty() {
+            return Err(Error::EmptyScene);
+        }
+        let cfg = SahConfig { max_depth: self.config.max_depth.min(63), bins: self.config.bins.max(2), ..self.config };
+        let bounds: Vec<Aabb> = triangles.iter().map(Triangle::bounds).collect();
+        let centroids: Vec<Vec3> = bounds.iter().map(Aabb::center).collect();
+        let mut prims: Vec<u32> = (0..triangles.len() as u32).collect();
+        let mut nodes: Vec<Bvh2Node> = Vec::with_capacity(2 * triangles.len());
+        nodes.push(Bvh2Node { bounds: Aabb::EMPTY, kind: NodeKind::Leaf { first: 0, count: 0 } });
+        let mut todo = alloc::vec![Work { slot: 0, start: 0, end: prims.len(), depth: 0 }];
+        let mut bins = alloc::vec![Bin { bounds: Aabb::EMPTY, count: 0 }; cfg.bins];
+        let mut right_area = alloc::vec![0.0f32; cfg.bins];
+        while let Some(w) = todo.pop() {
+            let range = &mut prims[w.start..w.end];
+            let (node_bounds, cbounds) = range.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), &p| {
+                (b.union(bounds[p as usize]), c.grow(centroids[p as usize]))
+            });
+            nodes[w.slot].bounds = node_bounds;
+            let count = range.len();
+            let leaf = NodeKind::Leaf { first: w.start as u32, count: count as u32 };
+            if count == 1 || w.depth >= cfg.max_depth {
+                nodes[w.slot].kind = leaf;
+                continue;
+            }
+            let leaf_cost = cfg.intersection_cost * count as f32;
+            let best = best_binned_split(range, &bounds, &centroids, cbounds, &cfg, &mut bins, &mut right_area);
+            let parent_area = node_bounds.half_area().max(f32::MIN_POSITIVE);
+            let mid = match best {
+                Some((axis, split, cost)) => {
+                    let split_cost = cfg.traversal_cost + cfg.intersection_cost * cost / parent_area;
+                    if split_cost >= leaf_cost && count as u32 <= cfg.max_leaf_size {
+                        nodes[w.slot].kind = leaf;
+                        continue;
+                    }
+                    let k = bin_scale(cbounds, axis, cfg.bins);
+                    let mut i = 0;
+                    for j in 0..range.len() {
+                        if bin_of(centroids[range[j] as usize][axis], cbounds.min[axis], k, cfg.bins) < split {
+                            range.swap(i, j);
+                            i += 1;
+                        }
+                    }
+                    i
+                }
+                None if count as u32 <= cfg.max_leaf_size => {
+                    nodes[w.slot].kind = leaf;
+                    continue;
+                }
+                None => 0,
+            };
+            let mid = if mid == 0 || mid == count {
+                // Binning could not separate (coincident centroids): median split by centroid on
+                // the widest axis, ties broken by primitive id so the tree is deterministic.
+                let axis = cbounds.extent().max_position();
+                range.sort_unstable_by(|&a, &b| {
+                    centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis]).then(a.cmp(&b))
+                });
+                count / 2
+            } else {
+                mid
+            };
+            let left = nodes.len();
+            nodes.push(Bvh2Node { bounds: Aabb::EMPTY, kind: leaf });
+            nodes.push(Bvh2Node { bounds: Aabb::EMPTY, kind: leaf });
+            nodes[w.slot].kind = NodeKind::Internal { left: left as u32, right: left as u32 + 1 };
+            todo.push(Work { slot: left + 1, start: w.start + mid, end: w.end, depth: w.depth + 1 });
+            todo.push(Work { slot: left, start: w.start, end: w.start + mid, depth: w.depth + 1 });
+        }
+        Bvh2::from_nodes(&nodes, 0, prims)
+    }
+}
+
+#[inline]
+fn bin_scale(cbounds: Aabb, axis: usize, bins: usize) -> f32 {
+    let e = cbounds.max[axis] - cbounds.min[axis];
+    if e > 0.0 {
+        bins as f32 / e
+    } else {
+        0.0
+    }
+}
+
+#[inline]
+fn bin_of(c: f32, min: f32, scale: f32, bins: usize) -> usize {
+    (((c - min) * scale) as usize).min(bins - 1)
+}
+
+/// The best (axis, first bin of the right side, unnormalized cost `A_l N_l + A_r N_r`).
+fn best_binned_split(
+    range: &[u32],
+    bounds: &[Aabb],
+    centroids: &[Vec3],
+    cbounds: Aabb,
+    cfg: &SahConfig,
+    bins: &mut [Bin],
+    right_area: &mut [f32],
+) -> Option<(usize, usize, f32)> {
+    let mut best: Option<(usize, usize, f32)> = None;
+    for axis in 0..3 {
+        let scale = bin_scale(cbounds, axis, cfg.bins);
+        if scale == 0.0 || !scale.is_finite() {
+            continue;
+        }
+        bins.fill(Bin { bounds: Aabb::EMPTY, count: 0 });
+        for &p in range {
+            let b = &mut bins[bin_of(centroids[p as usize][axis], cbounds.min[axis], scale, cfg.bins)];
+            b.bounds = b.bounds.union(bounds[p as usize]);
+            b.count += 1;
+        }
+        // Sweep from the right, recording area * count of everything at or right of each bin.
+        let (mut acc, mut n) = (Aabb::EMPTY, 0u32);
+        for i in (1..cfg.bins).rev() {
+            acc = acc.union(bins[i].bounds);
+            n += bins[i].count;
+            right_area[i] = acc.half_area() * n as f32;
+        }
+        let (mut acc, mut n) = (Aabb::EMPTY, 0u32);
+        for i in 1..cfg.bins {
+            acc = acc.union(bins[i - 1].bounds);
+            n += bins[i - 1].count;
+            if n == 0 || n as usize == range.len() {
+                continue;
+            }
+            let cost = acc.half_area() * n as f32 + right_area[i];
+            if best.is_none_or(|(_, _, c)| cost < c) {
+                best = Some((axis, i, cost));
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(n: usize) -> Vec<Triangle> {
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let (x, y) = (i as f32, j as f32);
+                t.push(Triangle::new(Vec3::new(x, y, 0.0), Vec3::new(x + 1.0, y, 0.0), Vec3::new(x, y + 1.0, 0.0)));
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn builds_a_valid_tree_over_every_primitive() {
+        let tris = grid(30);
+        let bvh = SahBuilder::default().build(&tris).unwrap();
+        let s = bvh.stats();
+        assert_eq!(s.leaves, s.internal_nodes + 1);
+        assert!(s.max_leaf_size <= 8);
+        // Every node's bounds hold its children's.
+        for n in bvh.nodes() {
+            if let NodeKind::Internal { left, right } = n.kind {
+                assert!(n.bounds.contains(&bvh.nodes()[left as usize].bounds));
+                assert!(n.bounds.contains(&bvh.nodes()[right as usize].bounds));
+            }
+        }
+        let mut order = bvh.prim_order().to_vec();
+        order.sort_unstable();
+        assert_eq!(order, (0..900).collect::<Vec<u32>>());
+    }
+
+    #[test]
+    fn coincident_triangles_respect_the_leaf_size() {
+        let t = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+        let bvh = SahBuilder::default().build(&alloc::vec![t; 100]).unwrap();
+        assert!(bvh.stats().max_leaf_size <= 8);
+    }
+
+    #[test]
+    fn empty_input_is_an_error() {
+        assert_eq!(SahBuilder::default().build(&[]).unwrap_err(), Error::EmptyScene);
+    }
+}

@@ -1,0 +1,82 @@
+//! The error type of the core: every failure names what is wrong.
+
+use core::fmt;
+
+/// What can go wrong in the core. Library code returns these instead of panicking.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Error {
+    /// A scene with no triangles was given where one is needed.
+    EmptyScene,
+    /// A triangle references a vertex that does not exist.
+    VertexIndexOutOfRange {
+        /// Triangle index.
+        triangle: usize,
+        /// The offending vertex index.
+        index: u32,
+        /// Number of vertices.
+        vertex_count: usize,
+    },
+    /// A vertex has a NaN or infinite coordinate.
+    NonFiniteVertex {
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// The tree is deeper than 64-bit keys allow.
+    TreeTooDeep {
+        /// The tree's depth.
+        depth: u32,
+    },
+    /// Node or leaf addresses do not fit the 30 bits the node references reserve for them.
+    TreeTooLarge {
+        /// What overflowed.
+        what: &'static str,
+        /// Its size.
+        size: usize,
+    },
+    /// A tree handed to [`crate::bvh2::Bvh2::from_nodes`] is malformed.
+    MalformedTree(&'static str),
+    /// The hash tables could not be built within the table-size limit.
+    HashConstruction {
+        /// Number of keys.
+        keys: usize,
+        /// Largest table size tried.
+        table_size: u64,
+    },
+    /// Rays and hit buffer lengths differ.
+    BufferMismatch {
+        /// Number of rays.
+        rays: usize,
+        /// Number of hit slots.
+        hits: usize,
+    },
+    /// A method needs something the prepared scene was not built with.
+    NotPrepared {
+        /// The method.
+        method: &'static str,
+        /// What is missing.
+        missing: &'static str,
+    },
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::EmptyScene => write!(f, "the scene has no triangles"),
+            Error::VertexIndexOutOfRange { triangle, index, vertex_count } => {
+                write!(f, "triangle {triangle} references vertex {index}, but there are only {vertex_count} vertices")
+            }
+            Error::NonFiniteVertex { vertex } => write!(f, "vertex {vertex} has a NaN or infinite coordinate"),
+            Error::TreeTooDeep { depth } => write!(f, "tree depth {depth} exceeds the 63 levels that 64-bit keys allow"),
+            Error::TreeTooLarge { what, size } => write!(f, "{what} ({size}) exceeds the 2^30 addresses node references allow"),
+            Error::MalformedTree(why) => write!(f, "malformed tree: {why}"),
+            Error::HashConstruction { keys, table_size } => {
+                write!(f, "no perfect hash for {keys} keys up to table size {table_size}")
+            }
+            Error::BufferMismatch { rays, hits } => write!(f, "{rays} rays but {hits} hit slots"),
+            Error::NotPrepared { method, missing } => write!(f, "method {method} needs {missing}, which the scene was not prepared with"),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for Error {}

@@ -1,0 +1,51 @@
+use bytemuck::{Pod, Zeroable};
+
+/// The result of tracing one ray.
+///
+/// The layout (16 bytes: `t`, `prim`, `u`, `v`) is the one of the CLI's `.npy` hit files. A miss
+/// has `t = +inf` and `prim = u32::MAX`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Hit {
+    /// Ray parameter of the hit point.
+    pub t: f32,
+    /// Primitive (triangle) index in file order.
+    pub prim: u32,
+    /// Barycentric weight of the triangle's second vertex.
+    pub u: f32,
+    /// Barycentric weight of the triangle's third vertex.
+    pub v: f32,
+}
+
+impl Hit {
+    /// Primitive id of a miss.
+    pub const NO_PRIM: u32 = u32::MAX;
+    /// The miss.
+    pub const MISS: Hit = Hit { t: f32::INFINITY, prim: Self::NO_PRIM, u: 0.0, v: 0.0 };
+
+    /// Whether this is a hit.
+    #[inline(always)]
+    pub fn is_hit(&self) -> bool {
+        self.prim != Self::NO_PRIM
+    }
+
+    /// Whether a candidate at `t` on primitive `prim` replaces this one as the closest.
+    ///
+    /// Ties at equal `t` go to the smaller primitive id, so the closest hit never depends on the
+    /// order in which a method visits primitives.
+    #[inline(always)]
+    pub fn is_beaten_by(&self, t: f32, prim: u32) -> bool {
+        t < self.t || (t == self.t && prim < self.prim)
+    }
+
+    /// Whether two hits are identical bit for bit in `t` and `prim` (the conformance criterion).
+    pub fn same_as(&self, other: &Hit) -> bool {
+        self.prim == other.prim && self.t.to_bits() == other.t.to_bits()
+    }
+}
+
+impl Default for Hit {
+    fn default() -> Self {
+        Self::MISS
+    }
+}

@@ -1,0 +1,11 @@
+//! Plain geometric data: rays, boxes, hits and triangles.
+
+mod aabb;
+mod hit;
+mod ray;
+mod triangle;
+
+pub use aabb::Aabb;
+pub use hit::Hit;
+pub use ray::Ray;
+pub use triangle::Triangle;

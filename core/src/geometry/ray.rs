@@ -1,0 +1,55 @@
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+/// A ray with its parametric interval: points `origin + t * dir` for `t` in `[tmin, tmax]`.
+///
+/// The memory layout (32 bytes: origin xyz, tmin, direction xyz, tmax) is the one of the CLI's
+/// `.npy` ray files and of the GPU ray buffers.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Ray {
+    /// Origin.
+    pub origin: [f32; 3],
+    /// Start of the interval.
+    pub tmin: f32,
+    /// Direction; need not be normalized.
+    pub dir: [f32; 3],
+    /// End of the interval; may be `+inf`.
+    pub tmax: f32,
+}
+
+impl Ray {
+    /// A ray over `[tmin, tmax]`.
+    pub fn new(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Self {
+        Self { origin: origin.to_array(), tmin, dir: dir.to_array(), tmax }
+    }
+
+    /// Origin as a vector.
+    #[inline(always)]
+    pub fn origin(&self) -> Vec3 {
+        Vec3::from_array(self.origin)
+    }
+
+    /// Direction as a vector.
+    #[inline(always)]
+    pub fn dir(&self) -> Vec3 {
+        Vec3::from_array(self.dir)
+    }
+
+    /// Whether the ray can hit anything at all.
+    ///
+    /// Rays with a NaN or infinite origin or direction component, a zero direction, a NaN bound, or
+    /// `tmin > tmax` are a documented miss: every method returns no hit for them without visiting a
+    /// node.
+    #[inline]
+    pub fn is_traceable(&self) -> bool {
+        let o = self.origin();
+        let d = self.dir();
+        o.is_finite()
+            && d.is_finite()
+            && d != Vec3::ZERO
+            && !self.tmin.is_nan()
+            && !self.tmax.is_nan()
+            && self.tmin <= self.tmax
+    }
+}

@@ -1,0 +1,40 @@
+//! The ray/box and ray/triangle tests every method shares.
+//!
+//! Per-ray constants (reciprocal direction, octant, shear) are computed once per ray by
+//! [`RayContext::new`], in one place, so that every method and backend makes the same decisions.
+
+mod context;
+mod moller_trumbore;
+mod slab;
+mod watertight;
+
+pub use context::RayContext;
+pub use moller_trumbore::MollerTrumbore;
+pub use slab::{BoxHit, SlabRay, FAR_PAD};
+pub use watertight::Watertight;
+
+use crate::Ray;
+use glam::Vec3;
+
+/// A ray/triangle hit before it is attributed to a primitive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    /// Ray parameter.
+    pub t: f32,
+    /// Barycentric weight of the second vertex.
+    pub u: f32,
+    /// Barycentric weight of the third vertex.
+    pub v: f32,
+}
+
+/// A ray/triangle test, chosen at compile time so the hot loop is monomorphized.
+pub trait TriangleTest: Copy + Default + Send + Sync + 'static {
+    /// Per-ray constants, computed once per ray.
+    type PerRay: Copy;
+    /// Short name, as used on the command line.
+    const NAME: &'static str;
+    /// Computes the per-ray constants.
+    fn prepare(ray: &Ray) -> Self::PerRay;
+    /// Hit of the ray with triangle `(a, b, c)` for `t` in `[tmin, tmax]`, if any.
+    fn intersect(ray: &Self::PerRay, a: Vec3, b: Vec3, c: Vec3, tmin: f32, tmax: f32) -> Option<TriangleHit>;
+}

@@ -1,0 +1,34 @@
+//! raytrail-core: the `no_std` heart of raytrail.
+//!
+//! Everything a traversal needs and nothing it does not: ray, box and hit types, the robust box and
+//! triangle tests, key and bit-trail arithmetic, node layouts, perfect hashing and the traversal
+//! state machines. Builders and table construction need the `alloc` feature; file loading needs
+//! `std` (the default).
+//!
+//! The canonical tree ([`bvh2::Bvh2`]) is the single source of truth: every layout is a view of it,
+//! and node identity in enumerations is the node's index in the canonical tree.
+#![no_std]
+#![warn(missing_docs)]
+
+#[cfg(feature = "alloc")]
+extern crate alloc;
+#[cfg(feature = "std")]
+extern crate std;
+
+pub mod bvh2;
+pub mod error;
+pub mod geometry;
+pub mod hash;
+pub mod intersect;
+pub mod key;
+#[cfg(feature = "std")]
+pub mod mesh;
+pub mod observe;
+#[cfg(feature = "alloc")]
+pub mod scene;
+#[cfg(feature = "alloc")]
+pub mod trace;
+pub mod traverse;
+
+pub use error::Error;
+pub use geometry::{Aabb, Hit, Ray};

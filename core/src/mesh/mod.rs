@@ -1,0 +1,1 @@
+//! Mesh files: OBJ (through tobj) and PLY (ASCII and binary, optionally gzip).

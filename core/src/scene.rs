@@ -1,0 +1,73 @@
+//! Triangle meshes as loaded, and validated triangle scenes.
+
+use crate::geometry::Triangle;
+use crate::{Aabb, Error};
+use alloc::vec::Vec;
+use glam::Vec3;
+
+/// An indexed triangle mesh as loaded from a file: primitive id = index into `triangles`
+/// (file order, polygons fan-split).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Vertex indices of each triangle.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// Checks indices and coordinates and gathers the triangles' vertices.
+    pub fn to_scene(&self) -> Result<Scene, Error> {
+        if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::NonFiniteVertex { vertex: v });
+        }
+        let n = self.positions.len();
+        let mut tris = Vec::with_capacity(self.triangles.len());
+        for (i, t) in self.triangles.iter().enumerate() {
+            let mut v = [Vec3::ZERO; 3];
+            for (slot, &idx) in v.iter_mut().zip(t) {
+                *slot = *self.positions.get(idx as usize).ok_or(Error::VertexIndexOutOfRange {
+                    triangle: i,
+                    index: idx,
+                    vertex_count: n,
+                })?;
+            }
+            tris.push(Triangle { v });
+        }
+        Scene::new(tris)
+    }
+}
+
+/// A triangle scene ready for building: at least one triangle, all coordinates finite.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    triangles: Vec<Triangle>,
+    bounds: Aabb,
+}
+
+impl Scene {
+    /// A scene of the given triangles (primitive id = index).
+    pub fn new(triangles: Vec<Triangle>) -> Result<Scene, Error> {
+        if triangles.is_empty() {
+            return Err(Error::EmptyScene);
+        }
+        let mut bounds = Aabb::EMPTY;
+        for (i, t) in triangles.iter().enumerate() {
+            if t.v.iter().any(|v| !v.is_finite()) {
+                return Err(Error::NonFiniteVertex { vertex: 3 * i });
+            }
+            bounds = bounds.union(t.bounds());
+        }
+        Ok(Scene { triangles, bounds })
+    }
+
+    /// The triangles, by primitive id.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// Bounds of all triangles.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+}
