@@ -25,6 +25,8 @@ pub mod key;
 pub mod mesh;
 pub mod observe;
 #[cfg(feature = "alloc")]
+pub mod prepared;
+#[cfg(feature = "alloc")]
 pub mod scene;
 #[cfg(feature = "alloc")]
 pub mod trace;

@@ -1,1 +1,17 @@
-//! CPU backend.
+//! raytrail-cpu: the rayon CPU backend of raytrail.
+//!
+//! [`CpuBackend`] implements the backend-agnostic [`Trace`](raytrail_core::trace::Trace) trait:
+//! rays are split into chunks traced in parallel, each chunk through the core's state machines
+//! monomorphized for the tree's key width, the triangle test and what is recorded, so the fast
+//! path carries no observer at all.
+//!
+//! The crate also holds the std-side helpers: the obvhs (PLOC) BVH2 builder ([`ploc`]) and NumPy
+//! ray and hit files ([`npy`]).
+#![warn(missing_docs)]
+
+mod backend;
+mod dispatch;
+pub mod npy;
+pub mod ploc;
+
+pub use backend::{CpuBackend, CpuScene};

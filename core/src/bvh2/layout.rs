@@ -99,11 +99,16 @@ impl BinaryLayout {
                 }
                 NodeKind::Leaf { first, count } => {
                     leaf_ids[leaves.len()] = i as u32;
-                    for &p in &bvh.prim_order()[first as usize..(first + count) as usize] {
+                    let prims = &bvh.prim_order()[first as usize..(first + count) as usize];
+                    for (j, &p) in prims.iter().enumerate() {
                         let t = triangles.get(p as usize).ok_or(Error::MalformedTree("primitive id beyond the triangles"))?;
+                        // The free slots of the first triangle's second and third entries carry the
+                        // first two links, so iterative backtracking can hop over a leaf without
+                        // searching for its terminator (Binder & Keller 2016, Sec. 2.2, side note).
+                        let (s1, s2) = if j == 0 { (l[0].0, l[1].0) } else { (0, 0) };
                         leaves.push(LeafWord::vertex_entry(t.v[0], p));
-                        leaves.push(LeafWord::vertex_entry(t.v[1], 0));
-                        leaves.push(LeafWord::vertex_entry(t.v[2], 0));
+                        leaves.push(LeafWord::vertex_entry(t.v[1], s1));
+                        leaves.push(LeafWord::vertex_entry(t.v[2], s2));
                     }
                     leaves.push(LeafWord::terminator(l));
                 }

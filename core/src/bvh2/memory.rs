@@ -1,4 +1,5 @@
-use super::{BinaryNode, LeafWord};
+use super::{BinaryNode, LeafWord, NodeRef};
+use crate::hash::HashShape;
 
 /// Every memory read a BVH2 traversal makes goes through this trait, so that the same state
 /// machine runs on slices (the CPU backend), under a traffic counter (the hardware simulator) or
@@ -12,4 +13,55 @@ pub trait BvhMemory {
     fn displacement(&self, slot: u32) -> i32;
     /// Perfect-hash table cell `slot`.
     fn hash_cell(&self, slot: u32) -> u32;
+    /// Sizes of the hash tables (a constant of the scene).
+    fn hash_shape(&self) -> HashShape;
+
+    /// The first two links of a node (internal: its link slots; leaf: the free slots of its
+    /// first triangle), read without searching for a leaf's terminator.
+    #[inline(always)]
+    fn hop_links(&self, r: NodeRef) -> [NodeRef; 2] {
+        if r.is_leaf() {
+            [self.leaf_word(r.offset() + 1).slot_link(), self.leaf_word(r.offset() + 2).slot_link()]
+        } else {
+            self.node(r.index()).links
+        }
+    }
+}
+
+/// Node data and hash tables in plain slices: the CPU backend's memory.
+#[derive(Clone, Copy, Debug)]
+pub struct SliceMemory<'a> {
+    /// Internal nodes.
+    pub nodes: &'a [BinaryNode],
+    /// Leaf entries.
+    pub leaves: &'a [LeafWord],
+    /// Displacement table (empty when the scene has no hash).
+    pub displacement: &'a [i32],
+    /// Hash table cells.
+    pub cells: &'a [u32],
+    /// Table sizes.
+    pub shape: HashShape,
+}
+
+impl BvhMemory for SliceMemory<'_> {
+    #[inline(always)]
+    fn node(&self, index: u32) -> BinaryNode {
+        self.nodes[index as usize]
+    }
+    #[inline(always)]
+    fn leaf_word(&self, offset: u32) -> LeafWord {
+        self.leaves[offset as usize]
+    }
+    #[inline(always)]
+    fn displacement(&self, slot: u32) -> i32 {
+        self.displacement[slot as usize]
+    }
+    #[inline(always)]
+    fn hash_cell(&self, slot: u32) -> u32 {
+        self.cells[slot as usize]
+    }
+    #[inline(always)]
+    fn hash_shape(&self) -> HashShape {
+        self.shape
+    }
 }

@@ -91,7 +91,8 @@ impl BinaryNode {
 ///
 /// A leaf is a run of triangles, three entries each, closed by a termination entry
 /// (Binder & Keller 2016, Fig. 5):
-/// - triangle entry 0: `v0.xyz` and the primitive id; entries 1 and 2: `v1.xyz`, `v2.xyz` and 0;
+/// - triangle entry 0: `v0.xyz` and the primitive id; entries 1 and 2: `v1.xyz`, `v2.xyz` and, in
+///   the leaf's first triangle, the leaf's first two links (0 in later triangles);
 /// - termination entry: three link references and [`LeafWord::TERMINATOR`] in the last slot.
 ///
 /// The marker sits in the slot that holds the primitive id, not in `x` as in Aila & Laine, because
@@ -116,10 +117,16 @@ impl LeafWord {
         Vec3::new(f32::from_bits(self.0[0]), f32::from_bits(self.0[1]), f32::from_bits(self.0[2]))
     }
 
-    /// The primitive id of a triangle's first entry.
+    /// The primitive id of a triangle's first entry (or the link in entries 1 and 2).
     #[inline(always)]
     pub fn prim(&self) -> u32 {
         self.0[3]
+    }
+
+    /// The link held in the free slot of a leaf's first triangle's entry 1 or 2.
+    #[inline(always)]
+    pub fn slot_link(&self) -> NodeRef {
+        NodeRef(self.0[3])
     }
 
     /// The three link references of a termination entry.

@@ -1,0 +1,230 @@
+//! The conformance checks: every method against its reference, ray by ray.
+
+use raytrail_core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
+use raytrail_core::traverse::{Method, Query};
+use raytrail_core::{Error, Hit, Ray};
+use std::fmt;
+
+/// How a method's result for one ray differs from its reference's.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Difference {
+    /// Closest hits differ (primitive id or `t`, bit for bit).
+    Hit {
+        /// The reference's hit.
+        expected: Hit,
+        /// The method's hit.
+        got: Hit,
+    },
+    /// Any-hit answers differ.
+    Occlusion {
+        /// Whether the reference found a hit.
+        expected: bool,
+        /// Whether the method did.
+        got: bool,
+    },
+    /// Node enumerations differ.
+    Enumeration {
+        /// The reference's visited nodes (canonical ids).
+        expected: Vec<u32>,
+        /// The method's.
+        got: Vec<u32>,
+    },
+}
+
+/// One ray on which a method parts from its reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mismatch {
+    /// Scene name.
+    pub scene: String,
+    /// Ray set name.
+    pub ray_set: String,
+    /// Backend name.
+    pub backend: String,
+    /// The method checked.
+    pub method: Method,
+    /// The method it was checked against.
+    pub reference: Method,
+    /// Closest or any hit.
+    pub query: Query,
+    /// Index of the ray in its set.
+    pub ray_index: usize,
+    /// The ray.
+    pub ray: Ray,
+    /// What differs.
+    pub difference: Difference,
+}
+
+/// Index of the first entry where two sequences differ (the shorter one's length if one is a
+/// prefix of the other), or `None` if they are equal.
+pub fn parting_point(a: &[u32], b: &[u32]) -> Option<usize> {
+    if a == b {
+        return None;
+    }
+    Some(a.iter().zip(b).position(|(x, y)| x != y).unwrap_or(a.len().min(b.len())))
+}
+
+fn write_seq(f: &mut fmt::Formatter<'_>, name: &str, s: &[u32], at: usize) -> fmt::Result {
+    // Long enumerations are shown around the parting point.
+    let (from, to) = (at.saturating_sub(16), (at + 16).min(s.len()));
+    write!(f, "    {name} ({} nodes): ", s.len())?;
+    if from > 0 {
+        write!(f, "[{from} more] ")?;
+    }
+    for (i, n) in s[from..to].iter().enumerate() {
+        if from + i == at {
+            write!(f, ">>{n}<< ")?;
+        } else {
+            write!(f, "{n} ")?;
+        }
+    }
+    if to < s.len() {
+        write!(f, "[{} more]", s.len() - to)?;
+    }
+    writeln!(f)
+}
+
+impl fmt::Display for Mismatch {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "MISMATCH scene={} rays={} ray#{} backend={} method={} vs {} ({} hit)",
+            self.scene,
+            self.ray_set,
+            self.ray_index,
+            self.backend,
+            self.method,
+            self.reference,
+            self.query.name()
+        )?;
+        let r = &self.ray;
+        writeln!(f, "    ray: origin {:?} dir {:?} t in [{:?}, {:?}]", r.origin, r.dir, r.tmin, r.tmax)?;
+        match &self.difference {
+            Difference::Hit { expected, got } => {
+                writeln!(f, "    expected hit {expected:?} (t bits {:#010x})", expected.t.to_bits())?;
+                writeln!(f, "    got      hit {got:?} (t bits {:#010x})", got.t.to_bits())
+            }
+            Difference::Occlusion { expected, got } => writeln!(f, "    expected occluded={expected}, got {got}"),
+            Difference::Enumeration { expected, got } => {
+                let at = parting_point(expected, got).unwrap_or(0);
+                writeln!(f, "    enumerations part at position {at}:")?;
+                write_seq(f, self.reference.name(), expected, at)?;
+                write_seq(f, self.method.name(), got, at)
+            }
+        }
+    }
+}
+
+/// One ray set's results for one method and query.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The method.
+    pub method: Method,
+    /// The query.
+    pub query: Query,
+    /// Hits per ray.
+    pub hits: Vec<Hit>,
+    /// Enumerations per ray.
+    pub enumerations: Vec<Vec<u32>>,
+}
+
+/// Traces `rays` with every method in `methods` for `query`, recording enumerations.
+pub fn trace_all<B: Trace>(
+    backend: &B,
+    scene: &B::Prepared,
+    rays: &[Ray],
+    methods: &[Method],
+    query: Query,
+) -> Result<Vec<Outcome>, Error> {
+    methods
+        .iter()
+        .map(|&method| {
+            let opts = TraceOptions { method, query, triangle_test: TriangleTestKind::Watertight, record: Record::Enumerations };
+            let mut hits = vec![Hit::MISS; rays.len()];
+            let report = backend.trace(scene, rays, &opts, &mut hits)?;
+            Ok(Outcome { method, query, hits, enumerations: report.enumerations })
+        })
+        .collect()
+}
+
+/// Where a check ran.
+#[derive(Clone, Copy, Debug)]
+pub struct Context<'a> {
+    /// Scene name.
+    pub scene: &'a str,
+    /// Ray set name.
+    pub ray_set: &'a str,
+    /// Backend name.
+    pub backend: &'a str,
+}
+
+/// Compares every outcome with its method's reference ([`Method::reference`] for enumerations,
+/// the stack method for hits). Returns every mismatch.
+pub fn compare(ctx: Context<'_>, rays: &[Ray], outcomes: &[Outcome]) -> Vec<Mismatch> {
+    let find = |m: Method, q: Query| outcomes.iter().find(|o| o.method == m && o.query == q);
+    let mut out = Vec::new();
+    for o in outcomes {
+        let mismatch = |i: usize, reference: Method, difference: Difference| Mismatch {
+            scene: ctx.scene.to_string(),
+            ray_set: ctx.ray_set.to_string(),
+            backend: ctx.backend.to_string(),
+            method: o.method,
+            reference,
+            query: o.query,
+            ray_index: i,
+            ray: rays[i],
+            difference,
+        };
+        if let Some(stack) = find(Method::Stack, o.query).filter(|_| o.method != Method::Stack) {
+            for (i, (e, g)) in stack.hits.iter().zip(&o.hits).enumerate() {
+                let differs = match o.query {
+                    Query::Closest => !e.same_as(g),
+                    Query::Any => e.is_hit() != g.is_hit(),
+                };
+                if differs {
+                    let d = match o.query {
+                        Query::Closest => Difference::Hit { expected: *e, got: *g },
+                        Query::Any => Difference::Occlusion { expected: e.is_hit(), got: g.is_hit() },
+                    };
+                    out.push(mismatch(i, Method::Stack, d));
+                }
+            }
+        }
+        let reference = o.method.reference();
+        if let Some(r) = find(reference, o.query).filter(|_| reference != o.method) {
+            for (i, (e, g)) in r.enumerations.iter().zip(&o.enumerations).enumerate() {
+                if e != g {
+                    out.push(mismatch(i, reference, Difference::Enumeration { expected: e.clone(), got: g.clone() }));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Runs every method for both queries on one ray set and compares; the mismatches found.
+pub fn check_ray_set<B: Trace>(
+    backend: &B,
+    scene: &B::Prepared,
+    ctx: Context<'_>,
+    rays: &[Ray],
+    methods: &[Method],
+) -> Result<Vec<Mismatch>, Error> {
+    let mut all = Vec::new();
+    for query in [Query::Closest, Query::Any] {
+        let outcomes = trace_all(backend, scene, rays, methods, query)?;
+        all.extend(compare(ctx, rays, &outcomes));
+    }
+    Ok(all)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parting_points() {
+        assert_eq!(parting_point(&[1, 2, 3], &[1, 2, 3]), None);
+        assert_eq!(parting_point(&[1, 2, 3], &[1, 5, 3]), Some(1));
+        assert_eq!(parting_point(&[1, 2], &[1, 2, 3]), Some(2));
+    }
+}

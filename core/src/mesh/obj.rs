@@ -1,0 +1,359 @@
+//! OBJ through tobj, with the line numbers and guarantees tobj does not give.
+//!
+//! What tobj does, checked against tobj 4.0: with `triangulate` it splits quads as `(a,b,c),(a,c,d)`
+//! and larger polygons as fans `(v0, vi, vi+1)`; models come out in file order (a new model at each
+//! `o`, `g` or material change) and faces keep their order inside a model. Concatenating the models
+//! therefore gives primitive ids in file order. What it does not do, and this module adds:
+//! - Errors carry no position: a [`Tracked`] reader remembers how far tobj read.
+//! - Index range errors surface only when tobj closes a model (next `o`/`g`/`usemtl` or end of
+//!   file): [`locate_bad_reference`] rescans to find the face that caused them.
+//! - It reads `l` (polyline) statements as faces, so `l 1 2 3` would become a triangle: such lines
+//!   are turned into comments before tobj sees them.
+//! - It silently turns faces of one or two vertices into degenerate triangles (or drops them):
+//!   these are rejected here, like in PLY.
+//! - Arithmetic on hostile indices can overflow inside tobj (a panic with overflow checks on): the
+//!   call is guarded and the panic reported as an error.
+
+use super::MeshError;
+use crate::scene::Mesh;
+use glam::Vec3;
+use std::borrow::Cow;
+use std::boxed::Box;
+use std::format;
+use std::io::{self, BufRead, Read};
+use std::panic::{self, AssertUnwindSafe};
+use std::string::String;
+use std::vec::Vec;
+
+/// Parses OBJ text; `name` is used in errors.
+pub(super) fn parse(data: &[u8], name: &str) -> Result<Mesh, MeshError> {
+    let scan = prescan(data);
+    let text: Cow<[u8]> = if scan.polylines.is_empty() {
+        Cow::Borrowed(data)
+    } else {
+        let mut owned = data.to_vec();
+        for &at in &scan.polylines {
+            owned[at] = b'#';
+        }
+        Cow::Owned(owned)
+    };
+
+    let mut reader = Tracked { data: &text, pos: 0 };
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        // Separate position indices: positions are not duplicated per normal/texcoord.
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    // Materials are not needed; a failing loader only records the failure in tobj's result.
+    let result = panic::catch_unwind(AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
+    }));
+    let tobj_line = reader.line();
+
+    let failure = match result {
+        Ok(Ok((models, _materials))) => {
+            if let Some((line, n)) = scan.short_face {
+                return Err(short_face(name, line, n));
+            }
+            return concat(models, name);
+        }
+        Ok(Err(err)) => (err, None),
+        Err(payload) => (tobj::LoadError::GenericFailure, Some(panic_message(payload))),
+    };
+    Err(locate_failure(&text, name, tobj_line, failure, scan.short_face))
+}
+
+/// The first problem tobj ran into, positioned; a short face before it wins.
+fn locate_failure(
+    text: &[u8],
+    name: &str,
+    tobj_line: usize,
+    (err, panic_msg): (tobj::LoadError, Option<String>),
+    short: Option<(usize, usize)>,
+) -> MeshError {
+    use tobj::LoadError as E;
+    let deferred = panic_msg.is_some()
+        || matches!(
+            err,
+            E::FaceVertexOutOfBounds
+                | E::FaceTexCoordOutOfBounds
+                | E::FaceNormalOutOfBounds
+                | E::FaceColorOutOfBounds
+                | E::InvalidPolygon
+        );
+    let what = match &panic_msg {
+        Some(msg) => format!("tobj panicked ({msg})"),
+        None => format!("{err}"),
+    };
+    let mut found = match deferred.then(|| locate_bad_reference(text)).flatten() {
+        Some((line, why)) => MeshError::at_line(name, line, format!("{why} ({what})")),
+        None if deferred => MeshError::at_line(name, tobj_line, format!("{what} in the object ending here")),
+        None => MeshError::at_line(name, tobj_line, format!("{what}: {}", quote_line(text, tobj_line))),
+    };
+    if let Some((line, n)) = short {
+        if found.line.is_none_or(|l| line <= l) {
+            found = short_face(name, line, n);
+        }
+    }
+    found
+}
+
+fn short_face(name: &str, line: usize, vertices: usize) -> MeshError {
+    MeshError::at_line(name, line, format!("face has {vertices} vertices; a face needs at least 3"))
+}
+
+/// Appends tobj's models in order, offsetting each model's indices past the positions before it.
+fn concat(models: Vec<tobj::Model>, name: &str) -> Result<Mesh, MeshError> {
+    let mut mesh = Mesh::default();
+    mesh.positions.reserve(models.iter().map(|m| m.mesh.positions.len() / 3).sum());
+    mesh.triangles.reserve(models.iter().map(|m| m.mesh.indices.len() / 3).sum());
+    for model in models {
+        let (positions, indices) = (&model.mesh.positions, &model.mesh.indices);
+        if positions.len() % 3 != 0 || indices.len() % 3 != 0 {
+            return Err(MeshError::new(name, "tobj returned a malformed mesh"));
+        }
+        let base = u32::try_from(mesh.positions.len())
+            .ok()
+            .filter(|b| b.checked_add((positions.len() / 3) as u32).is_some())
+            .ok_or_else(|| MeshError::new(name, "more than 2^32 vertices"))?;
+        mesh.positions.extend(positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        mesh.triangles.extend(indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
+    }
+    Ok(mesh)
+}
+
+/// What a quick pass over the text finds before tobj runs.
+struct Prescan {
+    /// Byte offsets of the `l` keyword of polyline statements.
+    polylines: Vec<usize>,
+    /// The first face with fewer than 3 vertices: (line, vertex count).
+    short_face: Option<(usize, usize)>,
+}
+
+fn prescan(data: &[u8]) -> Prescan {
+    let mut scan = Prescan { polylines: Vec::new(), short_face: None };
+    for (i, (start, line)) in lines(data).enumerate() {
+        let mut words = words(line);
+        match words.next() {
+            Some(b"l") => scan.polylines.push(start + first_word_offset(line)),
+            Some(b"f") if scan.short_face.is_none() => {
+                let n = words.count();
+                if n < 3 {
+                    scan.short_face = Some((i + 1, n));
+                }
+            }
+            _ => {}
+        }
+    }
+    scan
+}
+
+/// Finds the first face whose vertex, texcoord or normal reference is out of range, resolving
+/// relative (negative) indices as tobj does: against the counts at the face.
+fn locate_bad_reference(data: &[u8]) -> Option<(usize, String)> {
+    const KINDS: [(&str, &str); 3] =
+        [("vertex", "vertices"), ("texture coordinate", "texture coordinates"), ("normal", "normals")];
+    // Defined vertices, texcoords, normals, and vertices carrying a color.
+    let mut defined = [0i64; 3];
+    let mut colored = 0i64;
+    for (i, (_, line)) in lines(data).enumerate() {
+        let mut words = words(line);
+        match words.next() {
+            Some(b"v") => {
+                defined[0] += 1;
+                colored += i64::from(words.count() == 6);
+            }
+            Some(b"vt") => defined[1] += 1,
+            Some(b"vn") => defined[2] += 1,
+            Some(b"f") => {
+                for word in words {
+                    for (k, part) in word.split(|&b| b == b'/').enumerate().take(3) {
+                        let Some(x) = std::str::from_utf8(part).ok().and_then(|s| s.parse::<i64>().ok()) else {
+                            continue;
+                        };
+                        let resolved = if x < 0 { defined[k] + x } else { x - 1 };
+                        // A texcoord or normal index of 0 means "none" to tobj; a vertex one is invalid.
+                        let missing_ok = k > 0 && x == 0;
+                        let checked = k == 0 || defined[k] > 0;
+                        if checked && !missing_ok && !(0..defined[k]).contains(&resolved) {
+                            let (one, many) = KINDS[k];
+                            let why =
+                                format!("face refers to {one} {x}, but {} {many} are defined before it", defined[k]);
+                            return Some((i + 1, why));
+                        }
+                        if k == 0 && colored > 0 && resolved >= colored {
+                            let why = format!("face uses vertex {x}, which has no color while others do");
+                            return Some((i + 1, why));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// Lines as tobj sees them (split at `\n`), with the byte offset where each starts.
+fn lines(data: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
+    let mut start = 0;
+    data.split(|&b| b == b'\n').map(move |line| {
+        let at = start;
+        start += line.len() + 1;
+        (at, line)
+    })
+}
+
+fn words(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    line.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty())
+}
+
+fn first_word_offset(line: &[u8]) -> usize {
+    line.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(0)
+}
+
+/// The text of a 1-based line, shortened, for error messages.
+fn quote_line(data: &[u8], line: usize) -> String {
+    let text = lines(data).nth(line.saturating_sub(1)).map(|(_, l)| l).unwrap_or_default();
+    let text = String::from_utf8_lossy(text);
+    let text = text.trim();
+    match text.char_indices().nth(60) {
+        Some((cut, _)) => format!("{:?}...", &text[..cut]),
+        None => format!("{text:?}"),
+    }
+}
+
+fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
+    match payload.downcast::<String>() {
+        Ok(s) => *s,
+        Err(payload) => payload.downcast_ref::<&str>().map_or_else(|| String::from("unknown panic"), |s| (*s).into()),
+    }
+}
+
+/// A reader over the text that remembers how far it has been consumed, so that tobj's position
+/// is known when it fails. Newlines are counted only then, keeping the hot path a pointer bump.
+struct Tracked<'a> {
+    data: &'a [u8],
+    pos: usize,
+}
+
+impl Tracked<'_> {
+    /// The 1-based line last handed out: tobj reads whole lines, so this is the one it was on.
+    fn line(&self) -> usize {
+        let read = &self.data[..self.pos];
+        let newlines = read.iter().filter(|&&b| b == b'\n').count();
+        match read.last() {
+            Some(b'\n') => newlines,
+            _ => newlines + 1,
+        }
+    }
+}
+
+impl Read for Tracked<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = (&self.data[self.pos..]).read(buf)?;
+        self.pos += n;
+        Ok(n)
+    }
+}
+
+impl BufRead for Tracked<'_> {
+    fn fill_buf(&mut self) -> io::Result<&[u8]> {
+        Ok(&self.data[self.pos..])
+    }
+
+    fn consume(&mut self, amt: usize) {
+        self.pos = (self.pos + amt).min(self.data.len());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::string::ToString;
+
+    fn err(text: &str) -> String {
+        parse(text.as_bytes(), "t.obj").unwrap_err().to_string()
+    }
+
+    #[test]
+    fn fans_in_file_order_across_objects() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 2 0\no a\nf 1 2 3 4 5\ng b\nf 3 2 1\no a\nf -1 -2 -3\n";
+        let m = parse(text.as_bytes(), "t.obj").unwrap();
+        let tris: Vec<[Vec3; 3]> = m.triangles.iter().map(|t| t.map(|i| m.positions[i as usize])).collect();
+        let v = |i: usize| [Vec3::ZERO, Vec3::X, Vec3::new(1., 1., 0.), Vec3::Y, Vec3::new(2., 2., 0.)][i - 1];
+        let want = [[1, 2, 3], [1, 3, 4], [1, 4, 5], [3, 2, 1], [5, 4, 3]].map(|t| t.map(v));
+        assert_eq!(tris, want);
+    }
+
+    #[test]
+    fn quads_and_texcoord_normal_forms() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3//1 4/1\n";
+        let m = parse(text.as_bytes(), "t.obj").unwrap();
+        assert_eq!(m.triangles.len(), 2);
+        assert_eq!(m.triangles[1].map(|i| m.positions[i as usize]), [Vec3::ZERO, Vec3::new(1., 1., 0.), Vec3::Y]);
+    }
+
+    #[test]
+    fn polylines_are_not_triangles() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\n  l 1 2 3\nl 1 2\nf 1 2 3\n";
+        assert_eq!(parse(text.as_bytes(), "t.obj").unwrap().triangles.len(), 1);
+    }
+
+    #[test]
+    fn materials_are_ignored() {
+        let text = "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl red\nf 1 2 3\nusemtl blue\nf 3 2 1\n";
+        assert_eq!(parse(text.as_bytes(), "t.obj").unwrap().triangles.len(), 2);
+    }
+
+    #[test]
+    fn errors_carry_the_line() {
+        assert_eq!(err("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 x 3\n"), "t.obj:4: face parse error: \"f 1 x 3\"");
+        assert_eq!(err("v 0 0 0\nv 1 0 0\nv 1"), "t.obj:3: position parse error: \"v 1\"");
+        assert_eq!(err("v 0 0 0\r\nv 1 0 0\r\nv 1 zz 0\r\n"), "t.obj:3: position parse error: \"v 1 zz 0\"");
+        assert!(err("v 0 0 0\nv 1 0 0\nf 1 2\nv 1 1 0\n").starts_with("t.obj:3: face has 2 vertices"));
+        assert!(err("v 0 0 0\nf\n").starts_with("t.obj:2: face has 0 vertices"));
+        // A short face after tobj's failure does not hide it.
+        assert!(err("v 0 0 0\nv 1 q 0\nf 1 2\n").starts_with("t.obj:2: position"));
+    }
+
+    #[test]
+    fn out_of_range_references_are_found() {
+        let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 2 4\nf 1 2 3\n");
+        assert!(e.starts_with("t.obj:5: face refers to vertex 4, but 3 vertices are"), "{e}");
+        let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 2 -4\no next\nf 1 2 3\n");
+        assert!(e.starts_with("t.obj:5: face refers to vertex -4"), "{e}");
+        let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n");
+        assert!(e.starts_with("t.obj:5: face refers to normal 2"), "{e}");
+        let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 0 1 2\n");
+        assert!(e.starts_with("t.obj:4: face refers to vertex 0"), "{e}");
+    }
+
+    #[test]
+    fn panics_inside_tobj_become_errors() {
+        // A relative texcoord index before the first texcoord: tobj computes 2 * (huge) + 1, which
+        // overflows (a panic when overflow checks are on, an error otherwise).
+        let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/-9 2/1 3/1\n");
+        assert!(e.starts_with("t.obj:5: face refers to texture coordinate -9"), "{e}");
+    }
+
+    #[test]
+    fn invalid_utf8_is_an_error_at_its_line() {
+        let e = parse(b"v 0 0 0\n\xff\xfe garbage\nv 1 1 1\n", "g.obj").unwrap_err().to_string();
+        assert!(e.starts_with("g.obj:2: read error"), "{e}");
+    }
+
+    #[test]
+    fn tracked_reader_line() {
+        let mut r = Tracked { data: b"a\nb\nc", pos: 0 };
+        assert_eq!(r.line(), 1);
+        let mut s = String::new();
+        r.read_line(&mut s).unwrap();
+        assert_eq!(r.line(), 1);
+        r.read_line(&mut s).unwrap();
+        r.read_line(&mut s).unwrap();
+        assert_eq!(r.line(), 3);
+    }
+}

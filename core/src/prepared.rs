@@ -1,0 +1,137 @@
+//! A canonical tree with the layouts and tables its methods need, and nothing more.
+
+use crate::bvh2::{BinaryLayout, Bvh2, LinkKind, NodeRef, SliceMemory};
+use crate::hash::{keys_to_hash, HashCoverage, HashShape, HashStats, PerfectHash};
+use crate::key::KeyWidth;
+use crate::scene::Scene;
+use crate::traverse::{Method, TraceRoot};
+use crate::Error;
+use alloc::vec::Vec;
+
+/// Seconds spent deriving each part (zero without the `std` feature, which has the clock).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PrepareTimings {
+    /// Both node layouts.
+    pub layouts: f64,
+    /// The hash over backtracking targets.
+    pub hash: f64,
+    /// The hash over every node.
+    pub full_hash: f64,
+}
+
+/// A perfect hash with its construction figures.
+#[derive(Clone, Debug)]
+pub struct BuiltHash {
+    /// The tables.
+    pub tables: PerfectHash,
+    /// Sizes and counts.
+    pub stats: HashStats,
+}
+
+/// The canonical BVH2 of a scene, with exactly the layouts and hash tables the requested methods
+/// use: a scene traced only with the stack method pays for no hash and no parent links.
+#[derive(Clone, Debug)]
+pub struct PreparedBvh2 {
+    /// The canonical tree.
+    pub bvh: Bvh2,
+    /// Layout with uncle links (every method but parent/sibling).
+    pub uncles: Option<BinaryLayout>,
+    /// Layout with parent and sibling links.
+    pub parents: Option<BinaryLayout>,
+    /// Hash over backtracking targets (methods d, e).
+    pub hash: Option<BuiltHash>,
+    /// Hash over every node (method f).
+    pub full_hash: Option<BuiltHash>,
+    /// Time spent on each part.
+    pub timings: PrepareTimings,
+}
+
+fn seconds_since(#[allow(unused)] start: Option<f64>) -> f64 {
+    #[cfg(feature = "std")]
+    {
+        use std::time::{SystemTime, UNIX_EPOCH};
+        let now = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64());
+        if let Some(s) = start {
+            return now - s;
+        }
+        return now;
+    }
+    #[cfg(not(feature = "std"))]
+    0.0
+}
+
+impl PreparedBvh2 {
+    /// Derives what `methods` need from `bvh` over `scene`.
+    pub fn new(scene: &Scene, bvh: Bvh2, methods: &[Method]) -> Result<PreparedBvh2, Error> {
+        let tris = scene.triangles();
+        let mut timings = PrepareTimings::default();
+        let t0 = seconds_since(None);
+        let needs_uncles = methods.iter().any(|m| !m.needs_parent_links());
+        let uncles = if needs_uncles { Some(BinaryLayout::new(&bvh, tris, LinkKind::Uncles)) } else { None }.transpose()?;
+        let parents = if methods.iter().any(|m| m.needs_parent_links()) {
+            Some(BinaryLayout::new(&bvh, tris, LinkKind::ParentSibling)).transpose()?
+        } else {
+            None
+        };
+        timings.layouts = seconds_since(Some(t0));
+        let build = |coverage: HashCoverage| -> Result<BuiltHash, Error> {
+            let layout = uncles.as_ref().ok_or(Error::NotPrepared { method: "hash", missing: "the uncle layout" })?;
+            let keys = bvh.keys();
+            let entries: Vec<(u64, NodeRef)> =
+                keys_to_hash(&bvh, coverage).into_iter().map(|i| (keys[i as usize], layout.refs[i as usize])).collect();
+            let (tables, stats) = PerfectHash::build(&entries, bvh.len())?;
+            Ok(BuiltHash { tables, stats })
+        };
+        let t1 = seconds_since(None);
+        let hash = if methods.iter().any(|m| m.needs_hash()) { Some(build(HashCoverage::Backtracking)?) } else { None };
+        timings.hash = seconds_since(Some(t1));
+        let t2 = seconds_since(None);
+        let full_hash = if methods.iter().any(|m| m.needs_full_hash()) { Some(build(HashCoverage::All)?) } else { None };
+        timings.full_hash = seconds_since(Some(t2));
+        Ok(PreparedBvh2 { bvh, uncles, parents, hash, full_hash, timings })
+    }
+
+    /// Key width the tree's depth needs.
+    pub fn key_width(&self) -> KeyWidth {
+        self.bvh.stats().key_width
+    }
+
+    /// The layout `method` traverses.
+    pub fn layout(&self, method: Method) -> Result<&BinaryLayout, Error> {
+        let (l, what) = if method.needs_parent_links() {
+            (&self.parents, "the parent/sibling layout")
+        } else {
+            (&self.uncles, "the uncle layout")
+        };
+        l.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: what })
+    }
+
+    /// The memory `method` reads: its layout and, for the hash methods, their tables.
+    pub fn memory(&self, method: Method) -> Result<SliceMemory<'_>, Error> {
+        let layout = self.layout(method)?;
+        let hash = if method.needs_full_hash() {
+            Some(self.full_hash.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "the full hash" })?)
+        } else if method.needs_hash() {
+            Some(self.hash.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "the hash tables" })?)
+        } else {
+            None
+        };
+        Ok(SliceMemory {
+            nodes: &layout.nodes,
+            leaves: &layout.leaves,
+            displacement: hash.map_or(&[], |h| &h.tables.displacement),
+            cells: hash.map_or(&[], |h| &h.tables.cells),
+            shape: hash.map_or(HashShape::default(), |h| h.tables.shape),
+        })
+    }
+
+    /// Where `method` starts.
+    pub fn root(&self, method: Method) -> Result<TraceRoot, Error> {
+        Ok(TraceRoot(self.layout(method)?.root))
+    }
+
+    /// Bytes of the uncle layout (the BVH the hash overhead is relative to).
+    pub fn bvh_bytes(&self) -> usize {
+        self.uncles.as_ref().or(self.parents.as_ref()).map_or(0, BinaryLayout::bytes)
+    }
+}

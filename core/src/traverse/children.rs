@@ -1,0 +1,41 @@
+use crate::bvh2::BinaryNode;
+use crate::intersect::{SlabRay, TriangleTest, RayContext};
+
+/// Where traversal goes from an internal node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Descent {
+    /// Both child boxes missed.
+    Neither,
+    /// Only child `0` (left) or `1` (right) is hit.
+    One(usize),
+    /// Both hit: visit `first` now and postpone the other. `disjoint` when the t-intervals do not
+    /// overlap (the first ends before the other starts), which the mask of Sec. 2.3 uses.
+    Both {
+        /// The closer child (ties go to the left).
+        first: usize,
+        /// Whether the two t-intervals are disjoint.
+        disjoint: bool,
+    },
+}
+
+/// Intersects the ray with both child boxes over `[tmin, limit]` and orders them: the child
+/// with the smaller entry distance first, ties to the left (the order every method shares).
+#[inline(always)]
+pub fn order_children<T: TriangleTest>(node: &BinaryNode, ctx: &RayContext<T>, limit: f32) -> Descent {
+    order_with(&ctx.slab, node, ctx.ray.tmin, limit)
+}
+
+#[inline(always)]
+fn order_with(slab: &SlabRay, node: &BinaryNode, tmin: f32, limit: f32) -> Descent {
+    let (l0, l1) = node.child_bounds(0);
+    let (r0, r1) = node.child_bounds(1);
+    match (slab.hit(l0, l1, tmin, limit), slab.hit(r0, r1, tmin, limit)) {
+        (None, None) => Descent::Neither,
+        (Some(_), None) => Descent::One(0),
+        (None, Some(_)) => Descent::One(1),
+        (Some(l), Some(r)) => {
+            let (a, b) = if r.t_enter < l.t_enter { (r, l) } else { (l, r) };
+            Descent::Both { first: (r.t_enter < l.t_enter) as usize, disjoint: a.t_exit < b.t_enter }
+        }
+    }
+}

@@ -1,0 +1,51 @@
+use super::{
+    trace_pausing, Method, ParentSiblingState, PerfectHashLookup, Query, QueryState, RegisterState, StackState, Step,
+    UncleHops,
+};
+use crate::bvh2::{BvhMemory, NodeRef};
+use crate::intersect::{RayContext, TriangleTest};
+use crate::key::Key;
+use crate::observe::Observer;
+use crate::{Hit, Ray};
+
+/// Where a traversal starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceRoot(pub NodeRef);
+
+/// Traces one ray with `method` over `mem` (which must hold what the method needs: the
+/// parent/sibling layout for [`Method::ParentSibling`], the uncle layout otherwise, and the hash
+/// tables for the hash methods). `K` is the key and trail type the tree's depth needs.
+///
+/// A ray that is not traceable ([`Ray::is_traceable`]) is a miss and visits nothing.
+#[inline]
+pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
+    method: Method,
+    mem: &M,
+    root: TraceRoot,
+    ray: &Ray,
+    query: Query,
+    obs: &mut O,
+) -> Hit {
+    if !ray.is_traceable() {
+        return Hit::MISS;
+    }
+    let ctx = RayContext::<T>::new(ray);
+    let mut q = QueryState::new(ray, query == Query::Any);
+    let r = root.0;
+    macro_rules! drive {
+        ($state:expr) => {{
+            let mut s = $state;
+            while s.step(mem, &ctx, &mut q, obs) != Step::Done {}
+        }};
+    }
+    match method {
+        Method::Stack => drive!(StackState::<false>::new(r)),
+        Method::StackDisjoint => drive!(StackState::<true>::new(r)),
+        Method::ParentSibling => drive!(ParentSiblingState::<K>::new(r)),
+        Method::Uncle => drive!(RegisterState::<K, UncleHops, false>::new(r)),
+        Method::Hash => drive!(RegisterState::<K, PerfectHashLookup, false>::new(r)),
+        Method::HashDisjoint => drive!(RegisterState::<K, PerfectHashLookup, true>::new(r)),
+        Method::HashResume => trace_pausing::<K, M, T, O>(mem, r, &ctx, &mut q, obs),
+    }
+    q.hit
+}

@@ -1,0 +1,52 @@
+//! The `raytrail` command line: the main job (no arguments), `trace`, and `rays`.
+
+mod args;
+mod progress;
+mod run;
+mod trace;
+
+const USAGE: &str = "\
+raytrail: ray-traversal methods for triangle scenes
+
+USAGE:
+  raytrail                      the main job on the built-in scene (same as `raytrail run`)
+  raytrail run [--scene FILE] [--builder sah|ploc] [--width W] [--height H] [--passes N]
+               [--threads N] [--check-rays N]
+      builds the BVH, derives layouts and hash tables, traces primary, shadow and diffuse rays
+      with every method, and prints Mrays/s, work per ray, state size and the conformance verdict
+  raytrail trace --scene FILE --rays RAYS.npy --method NAME --out HITS.npy [--any]
+               [--builder sah|ploc] [--moller-trumbore]
+      traces a NumPy ray file (float32, shape (N, 8): origin xyz, tmin, dir xyz, tmax) into a hit
+      file (fields t <f4, prim <u4, u <f4, v <f4; a miss has t = inf, prim = 0xFFFFFFFF)
+  raytrail rays --scene FILE --out RAYS.npy [--width W] [--height H]
+      writes primary rays (Morton order) framing the scene, for `trace`
+
+METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume
+SCENES:  OBJ, PLY (ASCII or binary), optionally gzip-compressed; `builtin` is a generated sphereflake";
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (cmd, rest) = match args.first().map(String::as_str) {
+        None => ("run", &args[..]),
+        Some("-h" | "--help" | "help") => {
+            println!("{USAGE}");
+            return;
+        }
+        Some(c) if c.starts_with("--") => ("run", &args[..]),
+        Some(c) => (c, &args[1..]),
+    };
+    let result = match cmd {
+        "run" => run::main(rest),
+        "trace" => trace::main(rest),
+        "rays" => trace::rays_main(rest),
+        other => Err(format!("unknown command '{other}'\n\n{USAGE}")),
+    };
+    match result {
+        Ok(0) => {}
+        Ok(code) => std::process::exit(code),
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(2);
+        }
+    }
+}

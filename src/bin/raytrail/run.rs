@@ -1,0 +1,184 @@
+//! The main job: build, prepare, trace primary, shadow and diffuse rays with every method, and
+//! report speed, work per ray, state size, hash-table figures and the conformance verdict.
+
+use crate::args::Args;
+use crate::progress::{timed, Progress};
+use raytrail::conformance::check::{check_ray_set, Context, Mismatch};
+use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
+use raytrail::core::observe::Counters;
+use raytrail::core::prepared::{BuiltHash, PreparedBvh2};
+use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
+use raytrail::core::traverse::{Method, Query};
+use raytrail::core::{Hit, Ray};
+use raytrail::cpu::{CpuBackend, CpuScene};
+use raytrail::{load_scene, Builder, BUILTIN_SCENE};
+use std::sync::Arc;
+
+const FLAGS: &[&str] = &["scene", "builder", "width", "height", "passes", "threads", "check-rays"];
+
+struct RaySetRun {
+    name: &'static str,
+    query: Query,
+    rays: Vec<Ray>,
+}
+
+pub fn main(args: &[String]) -> Result<i32, String> {
+    let a = Args::parse(args, &[])?;
+    a.only(FLAGS)?;
+    let scene_arg = a.get("scene").unwrap_or(BUILTIN_SCENE);
+    let builder = Builder::from_name(a.get("builder").unwrap_or("sah"))?;
+    let (width, height) = (a.num("width", 320u32)?, a.num("height", 240u32)?);
+    let passes = a.num("passes", 5usize)?.max(1);
+    let check_rays = a.num("check-rays", 8192usize)?;
+    let backend = match a.get("threads") {
+        Some(_) => CpuBackend::with_threads(a.num("threads", 1usize)?).map_err(|e| e.to_string())?,
+        None => CpuBackend::new(),
+    };
+
+    let (named, _) = timed(&format!("loading {scene_arg}"), || load_scene(scene_arg));
+    let named = named?;
+    let scene = &named.scene;
+    let (bvh, build_s) = timed(&format!("building the BVH2 ({}, {} triangles)", builder.name(), scene.triangles().len()), || {
+        builder.build(scene)
+    });
+    let bvh = bvh.map_err(|e| e.to_string())?;
+    let (prepared, _) = timed("deriving layouts and hash tables for every method", || {
+        PreparedBvh2::new(scene, bvh, &Method::ALL)
+    });
+    let prepared = Arc::new(prepared.map_err(|e| e.to_string())?);
+    print_scene(&named.name, builder, build_s, &prepared);
+
+    let cpu = backend.prepare(prepared.clone()).map_err(|e| e.to_string())?;
+    let sets = ray_sets(&backend, &cpu, scene, width, height)?;
+    let depth = prepared.bvh.stats().depth;
+    let key_bytes = prepared.key_width().bytes();
+    let mut failures: Vec<Mismatch> = Vec::new();
+    let mut progress = Progress::new("tracing", sets.len() * Method::ALL.len() * (passes + 1) + sets.len());
+    let mut tables = Vec::new();
+    for set in &sets {
+        let mut rows = Vec::new();
+        for method in Method::ALL {
+            let mut opts = TraceOptions { method, query: set.query, triangle_test: TriangleTestKind::Watertight, record: Record::Nothing };
+            let mut hits = vec![Hit::MISS; set.rays.len()];
+            let mut times = Vec::with_capacity(passes);
+            for _ in 0..passes {
+                let r = backend.trace(&cpu, &set.rays, &opts, &mut hits).map_err(|e| e.to_string())?;
+                times.push(r.seconds);
+                progress.step(&format!("{} {}", set.name, method));
+            }
+            opts.record = Record::Counters;
+            let counted = backend.trace(&cpu, &set.rays, &opts, &mut hits).map_err(|e| e.to_string())?;
+            progress.step(&format!("{} {} counters", set.name, method));
+            rows.push((method, median(&mut times), counted.counters.unwrap_or_default()));
+        }
+        // Conformance on an evenly spread subset: recording every node of every ray is heavy.
+        let step = set.rays.len().div_ceil(check_rays.max(1)).max(1);
+        let subset: Vec<Ray> = set.rays.iter().step_by(step).copied().collect();
+        let ctx = Context { scene: &named.name, ray_set: set.name, backend: backend.name() };
+        let mismatches = check_ray_set(&backend, &cpu, ctx, &subset, &Method::ALL).map_err(|e| e.to_string())?;
+        progress.step(&format!("{} conformance", set.name));
+        tables.push((set, rows, subset.len(), mismatches.clone()));
+        failures.extend(mismatches);
+    }
+    progress.finish();
+    for (set, rows, checked, mismatches) in &tables {
+        print_table(set, rows, *checked, mismatches, depth, key_bytes);
+    }
+    print_backtracking(&tables.iter().map(|(s, rows, ..)| (s.name, rows.clone())).collect::<Vec<_>>());
+    if failures.is_empty() {
+        println!("\nconformance: every method matches its reference on every checked ray (hits and node enumerations).");
+        Ok(0)
+    } else {
+        println!("\nCONFORMANCE FAILED: {} mismatches. The first ones:", failures.len());
+        for m in failures.iter().take(5) {
+            println!("{m}");
+        }
+        Ok(1)
+    }
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn ray_sets(backend: &CpuBackend, cpu: &CpuScene, scene: &raytrail::core::scene::Scene, w: u32, h: u32) -> Result<Vec<RaySetRun>, String> {
+    let prim = primary(scene, w, h);
+    let mut hits = vec![Hit::MISS; prim.len()];
+    backend.trace(cpu, &prim, &TraceOptions::new(Method::Stack), &mut hits).map_err(|e| e.to_string())?;
+    let bounds = scene.bounds();
+    let shadow_rays = shadow(&prim, &hits, default_light(bounds), scene_epsilon(bounds));
+    let diffuse_rays = diffuse(&prim, &hits, scene, RAY_SEED);
+    Ok(vec![
+        RaySetRun { name: "primary", query: Query::Closest, rays: prim },
+        RaySetRun { name: "shadow", query: Query::Any, rays: shadow_rays },
+        RaySetRun { name: "diffuse", query: Query::Closest, rays: diffuse_rays },
+    ])
+}
+
+fn mb(bytes: usize) -> f64 {
+    bytes as f64 / (1024.0 * 1024.0)
+}
+
+fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedBvh2) {
+    let s = p.bvh.stats();
+    println!("\nscene {name}: {} internal nodes, {} leaves (largest {}), depth {}, {} keys (the {} path)",
+        s.internal_nodes, s.leaves, s.max_leaf_size, s.depth, s.key_width,
+        if s.key_width == raytrail::core::key::KeyWidth::W32 { "fast 32-bit" } else { "64-bit, as the depth exceeds 31" });
+    println!("  BVH2 ({}) built in {:.3} s; layouts {:.1} MB (nodes and leaf triangles) in {:.1} ms",
+        builder.name(), build_s, mb(p.bvh_bytes()), 1e3 * p.timings.layouts);
+    let describe = |label: &str, h: &Option<BuiltHash>, secs: f64| {
+        if let Some(h) = h {
+            let st = &h.stats;
+            println!(
+                "  {label}: {} keys of {} nodes, D = {}, H = {}, {} direct, {:.2} MB = +{:.1}% of the BVH, built in {:.1} ms ({} batches, {} growths)",
+                st.keys, p.bvh.len(), st.d_size, st.h_size, st.direct, mb(st.bytes),
+                100.0 * st.bytes as f64 / p.bvh_bytes().max(1) as f64, 1e3 * secs, st.batches, st.growths
+            );
+        }
+    };
+    describe("hash tables (backtracking targets)", &p.hash, p.timings.hash);
+    describe("hash tables (every node, for resuming)", &p.full_hash, p.timings.full_hash);
+}
+
+fn per_ray(x: u64, c: &Counters) -> f64 {
+    x as f64 / c.rays.max(1) as f64
+}
+
+fn print_table(set: &RaySetRun, rows: &[(Method, f64, Counters)], checked: usize, mismatches: &[Mismatch], depth: u32, key_bytes: usize) {
+    println!("\n{} rays: {} ({} hit), median of timed passes; conformance on {} rays", set.name, set.rays.len(), set.query.name(), checked);
+    println!("  {:<15} {:>9} {:>10} {:>10} {:>12} {:>10} {:>10} {:>8}  {}", "method", "Mrays/s", "vs stack", "nodes/ray", "backtr./ray", "hash/ray", "links/ray", "state B", "conformance");
+    let stack_s = rows.iter().find(|r| r.0 == Method::Stack).map_or(0.0, |r| r.1);
+    for (m, secs, c) in rows {
+        let bad = mismatches.iter().filter(|x| x.method == *m).count();
+        println!(
+            "  {:<15} {:>9.2} {:>9.2}x {:>10.1} {:>12.2} {:>10.2} {:>10.2} {:>8}  {}",
+            m.name(),
+            set.rays.len() as f64 / secs / 1e6,
+            stack_s / secs,
+            per_ray(c.nodes(), c),
+            per_ray(c.backtracks, c),
+            per_ray(c.hash_lookups(), c),
+            per_ray(c.link_reads, c),
+            m.state_bytes(depth, key_bytes),
+            if bad == 0 { "ok".to_string() } else { format!("MISMATCH on {bad} checks") }
+        );
+    }
+}
+
+fn print_backtracking(sets: &[(&str, Vec<(Method, f64, Counters)>)]) {
+    println!("\nbacktracking steps of the hash method (Binder & Keller 2016, Fig. 3), share of all steps:");
+    println!("  {:<9} {:>10} {:>10} {:>10} {:>11} {:>10} {:>10}   levels climbed 0..6, 7+", "rays", "postponed", "uncle", "g-uncle", "gg-uncle", "hash", "direct");
+    for (name, rows) in sets {
+        let Some((_, _, c)) = rows.iter().find(|r| r.0 == Method::Hash) else { continue };
+        let total = c.backtracks.max(1) as f64;
+        let pct = |x: u64| format!("{:.1}%", 100.0 * x as f64 / total);
+        let levels: Vec<String> = c.levels.iter().map(|&l| format!("{:.0}", 100.0 * l as f64 / total)).collect();
+        println!(
+            "  {:<9} {:>10} {:>10} {:>10} {:>11} {:>10} {:>10}   {}%",
+            name, pct(c.register[0]), pct(c.register[1]), pct(c.register[2]), pct(c.register[3]),
+            pct(c.hash[0]), pct(c.hash[1]), levels.join(" ")
+        );
+    }
+    println!("  (register: postponed = stored on postponing; uncle, g-uncle, gg-uncle = loaded from links; hash: through the table; direct: from the displacement entry)");
+}

@@ -1,0 +1,53 @@
+//! `raytrail trace` and `raytrail rays`: NumPy files in and out.
+
+use crate::args::Args;
+use crate::progress::timed;
+use raytrail::conformance::rays::primary;
+use raytrail::core::prepared::PreparedBvh2;
+use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
+use raytrail::core::traverse::{Method, Query};
+use raytrail::core::Hit;
+use raytrail::cpu::{npy, CpuBackend};
+use raytrail::{load_scene, Builder};
+use std::sync::Arc;
+
+pub fn main(args: &[String]) -> Result<i32, String> {
+    let a = Args::parse(args, &["any", "moller-trumbore"])?;
+    a.only(&["scene", "rays", "method", "out", "any", "builder", "moller-trumbore"])?;
+    let method_name = a.get("method").unwrap_or("hash");
+    let method = Method::from_name(method_name).ok_or_else(|| {
+        format!("unknown method '{method_name}' (known: {})", Method::ALL.map(Method::name).join(", "))
+    })?;
+    let builder = Builder::from_name(a.get("builder").unwrap_or("sah"))?;
+    let named = load_scene(a.required("scene")?)?;
+    let rays_path = a.required("rays")?;
+    let out = a.required("out")?;
+    let rays = npy::read_rays(rays_path).map_err(|e| e.to_string())?;
+    let (bvh, _) = timed("building the BVH2", || builder.build(&named.scene));
+    let prepared = PreparedBvh2::new(&named.scene, bvh.map_err(|e| e.to_string())?, &[method]).map_err(|e| e.to_string())?;
+    let backend = CpuBackend::new();
+    let scene = backend.prepare(Arc::new(prepared)).map_err(|e| e.to_string())?;
+    let opts = TraceOptions {
+        method,
+        query: if a.has("any") { Query::Any } else { Query::Closest },
+        triangle_test: if a.has("moller-trumbore") { TriangleTestKind::MollerTrumbore } else { TriangleTestKind::Watertight },
+        record: Record::Nothing,
+    };
+    let mut hits = vec![Hit::MISS; rays.len()];
+    let report = backend.trace(&scene, &rays, &opts, &mut hits).map_err(|e| e.to_string())?;
+    npy::write_hits(out, &hits).map_err(|e| e.to_string())?;
+    let n_hit = hits.iter().filter(|h| h.is_hit()).count();
+    println!("{} rays, {} hits, {:.2} Mrays/s ({method}), written to {out}", rays.len(), n_hit, report.mrays_per_s());
+    Ok(0)
+}
+
+pub fn rays_main(args: &[String]) -> Result<i32, String> {
+    let a = Args::parse(args, &[])?;
+    a.only(&["scene", "out", "width", "height"])?;
+    let named = load_scene(a.required("scene")?)?;
+    let rays = primary(&named.scene, a.num("width", 320u32)?, a.num("height", 240u32)?);
+    let out = a.required("out")?;
+    npy::write_rays(out, &rays).map_err(|e| e.to_string())?;
+    println!("{} primary rays written to {out}", rays.len());
+    Ok(0)
+}
