@@ -127,7 +127,9 @@ impl PreparedBvh2 {
 
     /// Where `method` starts.
     pub fn root(&self, method: Method) -> Result<TraceRoot, Error> {
-        Ok(TraceRoot(self.layout(method)?.root))
+        let b = self.bvh.nodes()[0].bounds;
+        let scene_scale = b.min.abs().max(b.max.abs()).max_element();
+        Ok(TraceRoot { node: self.layout(method)?.root, scene_scale })
     }
 
     /// Bytes of the uncle layout (the BVH the hash overhead is relative to).

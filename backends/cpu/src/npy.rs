@@ -10,8 +10,8 @@
 //! literal with the keys `descr`, `fortran_order` and `shape`, padded with spaces and a final
 //! newline so the data starts at a multiple of 64 bytes, then the raw elements in C order.
 //!
-//! Writers produce version 1.0 (2.0 only if a header ever outgrew 64 KiB) with little-endian data,
-//! exactly as `numpy.save` does. Readers accept versions 1.0, 2.0 and 3.0, either byte order, and
+//! Writers produce version 1.0 (2.0 only if a header ever outgrew 64 KiB) with little-endian data:
+//! the same bytes as `numpy.save` (NumPy 1.24 and later, which pads the header a little more). Readers accept versions 1.0, 2.0 and 3.0, either byte order, and
 //! ignore anything after the array's data (as NumPy does). Every problem with the input is an
 //! [`NpyError`] that names the file and what is wrong; nothing here panics on bad input, and no
 //! allocation is sized from the header before the data backing it has been read.
@@ -29,6 +29,8 @@ const ALIGN: usize = 64;
 /// Largest header accepted; ours are under 128 bytes, NumPy itself refuses more than 10 000 by
 /// default. Bounds the allocation a hostile header length can cause.
 const MAX_HEADER_LEN: u64 = 1 << 20;
+/// Digits NumPy reserves in the header for the first extent (`GROWTH_AXIS_MAX_DIGITS`).
+const GROWTH_AXIS_MAX_DIGITS: usize = 21;
 /// Bytes converted per step when streaming data in or out.
 const CHUNK_BYTES: usize = 1 << 20;
 /// Nesting bound of the header parser, so a hostile header cannot exhaust the stack.
@@ -337,7 +339,7 @@ fn hit_fields(descr: &Value) -> Option<[bool; 4]> {
 }
 
 fn write_rays_impl(w: &mut impl Write, rays: &[Ray]) -> io::Result<()> {
-    write_header(w, "'<f4'", &format!("({}, 8)", rays.len()))?;
+    write_header(w, "'<f4'", &[rays.len(), 8])?;
     write_records(w, rays, RAY_BYTES, |ray, out| {
         let row = [ray.origin[0], ray.origin[1], ray.origin[2], ray.tmin, ray.dir[0], ray.dir[1], ray.dir[2], ray.tmax];
         for x in row {
@@ -347,7 +349,7 @@ fn write_rays_impl(w: &mut impl Write, rays: &[Ray]) -> io::Result<()> {
 }
 
 fn write_hits_impl(w: &mut impl Write, hits: &[Hit]) -> io::Result<()> {
-    write_header(w, HIT_DESCR, &format!("({},)", hits.len()))?;
+    write_header(w, HIT_DESCR, &[hits.len()])?;
     write_records(w, hits, HIT_BYTES, |hit, out| {
         out.extend_from_slice(&hit.t.to_le_bytes());
         out.extend_from_slice(&hit.prim.to_le_bytes());
@@ -566,15 +568,23 @@ fn read_records<T>(
     Ok(out)
 }
 
-/// Writes the preamble and the header dict, padded with spaces and a newline so that the data
-/// starts at a multiple of [`ALIGN`] bytes. `descr` and `shape` are Python literals.
-fn write_header(w: &mut impl Write, descr: &str, shape: &str) -> io::Result<()> {
-    let dict = format!("{{'descr': {descr}, 'fortran_order': False, 'shape': {shape}, }}");
+/// Writes the preamble and the header dict (`descr` is a Python literal), padded with spaces and
+/// a newline so that the data starts at a multiple of [`ALIGN`] bytes.
+fn write_header(w: &mut impl Write, descr: &str, shape: &[usize]) -> io::Result<()> {
+    let shape_u64: Vec<u64> = shape.iter().map(|&n| n as u64).collect();
+    let mut dict = format!("{{'descr': {descr}, 'fortran_order': False, 'shape': {}, }}", ShapeDisplay(&shape_u64));
+    // NumPy (since 1.24) leaves room for the first extent to grow to 21 digits in place; doing the
+    // same makes the files byte-identical to `numpy.save`'s.
+    if let Some(n) = shape.first() {
+        let digits = n.to_string().len();
+        dict.extend(std::iter::repeat_n(' ', GROWTH_AXIS_MAX_DIGITS.saturating_sub(digits)));
+    }
     // Version 1.0 (two length bytes) whenever the header fits, as NumPy does.
     let (version, len_bytes) = if 10 + dict.len() < usize::from(u16::MAX) - ALIGN { (1u8, 2) } else { (2u8, 4) };
     let preamble = MAGIC.len() + 2 + len_bytes;
-    // At least the newline follows the dict.
-    let header_len = (preamble + dict.len() + 1).next_multiple_of(ALIGN) - preamble;
+    // Spaces up to the alignment, then the newline; NumPy pads a whole extra [`ALIGN`] where no
+    // space would be needed, and so do we.
+    let header_len = dict.len() + 1 + ALIGN - (preamble + dict.len() + 1) % ALIGN;
     let mut out = Vec::with_capacity(preamble + header_len);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&[version, 0]);

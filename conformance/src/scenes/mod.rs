@@ -16,7 +16,7 @@ mod sphereflake;
 mod stack;
 mod tiny;
 
-pub use far::far_from_origin;
+pub use far::{far_from_origin, FAR_CENTER};
 pub use grid::shared_edge_grid;
 pub use soup::triangle_soup;
 pub use sphereflake::sphereflake;
@@ -59,4 +59,19 @@ pub fn generated() -> Vec<NamedScene> {
 /// A scene of generated triangles; generators only make non-empty, finite geometry.
 fn scene_of(triangles: Vec<Triangle>) -> Scene {
     Scene::new(triangles).expect("generated scenes are non-empty with finite vertices")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn generated_scenes_are_deterministic_and_named() {
+        let (a, b) = (generated(), generated());
+        let names: Vec<&str> = a.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["shared_edge_grid", "sphereflake", "triangle_soup", "degenerate_stack", "far_from_origin"]);
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x.scene, y.scene, "{}", x.name);
+        }
+    }
 }

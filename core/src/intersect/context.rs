@@ -10,12 +10,33 @@ pub struct RayContext<T: TriangleTest> {
     pub slab: SlabRay,
     /// Triangle-test constants.
     pub tri: T::PerRay,
+    /// A bound on how far a triangle hit's computed `t` may stray from the computed interval of
+    /// a box holding the triangle (see [`RayContext::new`]).
+    pub t_slack: f32,
 }
+
+/// Units of `f32::EPSILON` in [`RayContext::t_slack`]: generous against the few roundings of
+/// the watertight test's `t`, small against any real gap between boxes.
+const SLACK_ULPS: f32 = 64.0;
 
 impl<T: TriangleTest> RayContext<T> {
     /// Computes the per-ray constants; call only for a traceable ray ([`Ray::is_traceable`]).
+    ///
+    /// `scene_scale` is the largest coordinate magnitude in the scene. Box distances are computed
+    /// to a few ulps of `t`, but a triangle's `t` carries an absolute error of a few ulps of the
+    /// vertex coordinates relative to the origin, divided by the direction's size. The slack
+    /// bounds that error; comparisons that prune by `t` across boxes must exceed it.
     #[inline]
-    pub fn new(ray: &Ray) -> Self {
-        Self { ray: *ray, slab: SlabRay::new(ray), tri: T::prepare(ray) }
+    pub fn new(ray: &Ray, scene_scale: f32) -> Self {
+        let reach = scene_scale + ray.origin().abs().max_element();
+        let d = ray.dir().abs().max_element();
+        // The watertight test forms products of order reach^3 / |d|; where they come near the
+        // float range its `t` is unreliable, and an infinite slack turns pruning off.
+        let t_slack = if reach * reach * (reach / d) < f32::MAX / 256.0 {
+            SLACK_ULPS * f32::EPSILON * reach / d
+        } else {
+            f32::INFINITY
+        };
+        Self { ray: *ray, slab: SlabRay::new(ray), tri: T::prepare(ray), t_slack }
     }
 }

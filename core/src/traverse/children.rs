@@ -9,7 +9,8 @@ pub enum Descent {
     /// Only child `0` (left) or `1` (right) is hit.
     One(usize),
     /// Both hit: visit `first` now and postpone the other. `disjoint` when the t-intervals do not
-    /// overlap (the first ends before the other starts), which the mask of Sec. 2.3 uses.
+    /// overlap (the first ends before the other starts, by more than the ray's `t_slack`), which
+    /// the mask of Sec. 2.3 uses.
     Both {
         /// The closer child (ties go to the left).
         first: usize,
@@ -22,11 +23,11 @@ pub enum Descent {
 /// with the smaller entry distance first, ties to the left (the order every method shares).
 #[inline(always)]
 pub fn order_children<T: TriangleTest>(node: &BinaryNode, ctx: &RayContext<T>, limit: f32) -> Descent {
-    order_with(&ctx.slab, node, ctx.ray.tmin, limit)
+    order_with(&ctx.slab, node, ctx.ray.tmin, limit, ctx.t_slack)
 }
 
 #[inline(always)]
-fn order_with(slab: &SlabRay, node: &BinaryNode, tmin: f32, limit: f32) -> Descent {
+fn order_with(slab: &SlabRay, node: &BinaryNode, tmin: f32, limit: f32, slack: f32) -> Descent {
     let (l0, l1) = node.child_bounds(0);
     let (r0, r1) = node.child_bounds(1);
     match (slab.hit(l0, l1, tmin, limit), slab.hit(r0, r1, tmin, limit)) {
@@ -35,7 +36,12 @@ fn order_with(slab: &SlabRay, node: &BinaryNode, tmin: f32, limit: f32) -> Desce
         (None, Some(_)) => Descent::One(1),
         (Some(l), Some(r)) => {
             let (a, b) = if r.t_enter < l.t_enter { (r, l) } else { (l, r) };
-            Descent::Both { first: (r.t_enter < l.t_enter) as usize, disjoint: a.t_exit < b.t_enter }
+            // The paper's test is `a.t_exit < b.t_enter`. A triangle's computed `t` can fall
+            // outside its box's computed interval by rounding (a ray starting on a triangle's
+            // plane, a direction near the float limits), and pruning on a bare comparison then
+            // drops the true closest hit; the slack keeps the mask conservative. A NaN or
+            // infinite slack makes nothing disjoint.
+            Descent::Both { first: (r.t_enter < l.t_enter) as usize, disjoint: a.t_exit + slack < b.t_enter }
         }
     }
 }

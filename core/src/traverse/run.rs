@@ -8,9 +8,14 @@ use crate::key::Key;
 use crate::observe::Observer;
 use crate::{Hit, Ray};
 
-/// Where a traversal starts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct TraceRoot(pub NodeRef);
+/// Where a traversal starts, with the scene constant every ray needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TraceRoot {
+    /// The root node.
+    pub node: NodeRef,
+    /// The largest coordinate magnitude in the scene (for [`RayContext::new`]).
+    pub scene_scale: f32,
+}
 
 /// Traces one ray with `method` over `mem` (which must hold what the method needs: the
 /// parent/sibling layout for [`Method::ParentSibling`], the uncle layout otherwise, and the hash
@@ -29,9 +34,9 @@ pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
     if !ray.is_traceable() {
         return Hit::MISS;
     }
-    let ctx = RayContext::<T>::new(ray);
+    let ctx = RayContext::<T>::new(ray, root.scene_scale);
     let mut q = QueryState::new(ray, query == Query::Any);
-    let r = root.0;
+    let r = root.node;
     macro_rules! drive {
         ($state:expr) => {{
             let mut s = $state;
