@@ -46,17 +46,17 @@ pub struct PreparedBvh2 {
     pub timings: PrepareTimings,
 }
 
-fn seconds_since(#[allow(unused)] start: Option<f64>) -> f64 {
-    #[cfg(feature = "std")]
-    {
-        use std::time::{SystemTime, UNIX_EPOCH};
-        let now = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64());
-        if let Some(s) = start {
-            return now - s;
-        }
-        return now;
-    }
-    #[cfg(not(feature = "std"))]
+/// Seconds since `start` (a value this function returned), or a start mark when `None`.
+#[cfg(feature = "std")]
+fn seconds_since(start: Option<f64>) -> f64 {
+    use std::time::{SystemTime, UNIX_EPOCH};
+    let now = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64());
+    start.map_or(now, |s| now - s)
+}
+
+/// Without `std` there is no clock: every timing is zero.
+#[cfg(not(feature = "std"))]
+fn seconds_since(_start: Option<f64>) -> f64 {
     0.0
 }
 
@@ -129,7 +129,7 @@ impl PreparedBvh2 {
     pub fn root(&self, method: Method) -> Result<TraceRoot, Error> {
         let b = self.bvh.nodes()[0].bounds;
         let scene_scale = b.min.abs().max(b.max.abs()).max_element();
-        Ok(TraceRoot { node: self.layout(method)?.root, scene_scale })
+        Ok(TraceRoot { node: self.layout(method)?.root, scene_scale, max_steps: self.bvh.len() as u32 })
     }
 
     /// Bytes of the uncle layout (the BVH the hash overhead is relative to).

@@ -3,8 +3,13 @@
 //! obvhs builds a binary BVH bottom-up by PLOC (Meister and Bittner 2018: Morton-sorted
 //! primitives, each merged with the neighbour within a search window that gives the smallest box),
 //! then improves it by parallel reinsertion (Meister and Bittner 2022), collapses subtrees into
-//! leaves where the SAH prefers it, and reinserts again. It is usually faster to build than a
-//! top-down binned SAH builder ([`SahBuilder`]) and gives trees of similar SAH cost.
+//! leaves where the SAH prefers it, and reinserts again.
+//!
+//! Against [`SahBuilder`] (binned, 16 bins) run with the same traversal cost (3 intersection tests,
+//! the cost obvhs's leaf collapse uses), the measured SAH costs were 12% lower on Sponza and 22%
+//! lower on the kitchen scene, 5-12% higher on the bunny, the dragon and random triangle soups, and
+//! 25-70% higher on flat scenes such as a height-field grid: obvhs scales its Morton codes per
+//! axis, so a thin axis gets as many bits as the long ones.
 //!
 //! The settings are obvhs's `BvhBuildParams::medium_build()` preset, the one obvhs documents as
 //! "around the same build time as embree but with faster traversal" and uses in its own examples:
@@ -109,8 +114,9 @@ fn build_obvhs(triangles: &[Triangle]) -> obvhs::bvh2::Bvh2 {
         p.search_depth_threshold,
     );
     let mut reinsertion = ReinsertionOptimizer::default();
-    // Reinsertion's search stack is sized from `max_depth` (at least 96); it can deepen a tree, so
-    // give it twice the actual depth before each pass.
+    // Reinsertion's search stack holds 2 * `max_depth` entries and panics (or, in its fixed-size
+    // variant, overwrites) beyond that. PLOC sets `max_depth` from its pass count, which a deepening
+    // reinsertion can exceed: re-derive it from the actual depth before each pass.
     bvh.max_depth = bvh.max_depth.max(2 * obvhs_depth(&bvh) + 2);
     reinsertion.run(&mut bvh, p.reinsertion_batch_ratio, None);
     collapse(&mut bvh, p.max_prims_per_leaf.clamp(1, 255), p.collapse_traversal_cost);
@@ -127,7 +133,7 @@ fn obvhs_depth(bvh: &obvhs::bvh2::Bvh2) -> usize {
     while let Some((i, d)) = todo.pop() {
         let Some(n) = bvh.nodes.get(i) else { continue };
         deepest = deepest.max(d);
-        // A node can be reached at most once per node in a well-formed tree; bound the walk anyway.
+        // A well-formed tree never holds more pending nodes than it has; a cyclic one stops here.
         if !n.is_leaf() && todo.len() <= bvh.nodes.len() {
             let c = n.first_index as usize;
             todo.push((c, d + 1));
@@ -291,7 +297,10 @@ impl Imported {
                 }
                 NodeKind::Internal { left, right } => {
                     let slot = nodes.len();
-                    nodes.push(Bvh2Node { bounds: node.bounds, kind: NodeKind::Internal { left: u32::MAX, right: u32::MAX } });
+                    nodes.push(Bvh2Node {
+                        bounds: node.bounds,
+                        kind: NodeKind::Internal { left: u32::MAX, right: u32::MAX },
+                    });
                     todo.push((right, Some((slot, true))));
                     todo.push((left, Some((slot, false))));
                 }
@@ -393,7 +402,8 @@ mod tests {
             // obvhs collapses leaves with traversal cost 3 (intersection 1); SahBuilder's default
             // is 1. Compare each cost model against the SAH builder run with it.
             for ct in [1.0f32, 3.0] {
-                let sah = SahBuilder::new(SahConfig { traversal_cost: ct, ..SahConfig::default() }).build(&tris).unwrap();
+                let sah =
+                    SahBuilder::new(SahConfig { traversal_cost: ct, ..SahConfig::default() }).build(&tris).unwrap();
                 let (cp, cs) = (sah_cost(&ploc, f64::from(ct)), sah_cost(&sah, f64::from(ct)));
                 println!(
                     "{name}, traversal cost {ct}: SAH cost PLOC {cp:.2} (depth {}, {} leaves), SahBuilder {cs:.2} \
@@ -472,7 +482,10 @@ mod tests {
         assert!(obvhs_depth(&raw) > 63, "the scene must defeat the cap: obvhs depth {}", obvhs_depth(&raw));
         // A chain keeps its upper links; only its deep end is rebuilt, with room to spare.
         let roots = Imported::new(&raw, &tris).unwrap().subtrees_to_rebuild(63);
-        assert!(!roots.is_empty() && roots.iter().all(|&(_, depth)| depth > 0 && depth + REBUILD_SLACK < 63), "{roots:?}");
+        assert!(
+            !roots.is_empty() && roots.iter().all(|&(_, depth)| depth > 0 && depth + REBUILD_SLACK < 63),
+            "{roots:?}"
+        );
         let bvh = build_ploc(&tris, 63).unwrap();
         check(&bvh, &tris, 63);
         let bvh = build_ploc(&tris, 20).unwrap();

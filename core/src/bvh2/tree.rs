@@ -21,6 +21,9 @@ pub enum NodeKind {
     },
 }
 
+/// A node still to renumber: (old index, depth, the new parent and whether it is the right child).
+type Pending = (u32, u32, Option<(usize, bool)>);
+
 /// A node of the canonical tree.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bvh2Node {
@@ -70,8 +73,7 @@ impl Bvh2 {
         let mut prim_seen = alloc::vec![false; prim_order.len()];
         let mut new_order: Vec<u32> = Vec::with_capacity(prim_order.len());
         let mut stats = TreeStats { internal_nodes: 0, leaves: 0, depth: 0, max_leaf_size: 0, key_width: KeyWidth::W32 };
-        // (old index, depth, slot in `out` of the parent's child field to patch: (parent, is_right))
-        let mut todo: Vec<(u32, u32, Option<(usize, bool)>)> = alloc::vec![(root, 0, None)];
+        let mut todo: Vec<Pending> = alloc::vec![(root, 0, None)];
         while let Some((old, depth, patch)) = todo.pop() {
             let node = nodes.get(old as usize).ok_or(Error::MalformedTree("child index out of range"))?;
             if core::mem::replace(&mut seen[old as usize], true) {

@@ -44,7 +44,7 @@ impl TriangleTest for MollerTrumbore {
             return None;
         }
         let t = e2.dot(q) * inv;
-        if !(t >= tmin) || t > tmax {
+        if t.is_nan() || t < tmin || t > tmax {
             return None;
         }
         Some(TriangleHit { t, u, v })

@@ -79,8 +79,7 @@ impl TriangleTest for Watertight {
         let bz = sz * b[kz];
         let cz = sz * c[kz];
         let t = (u * az + v * bz + w * cz) / det;
-        // `!(t >= tmin)` also rejects a NaN t.
-        if !(t >= tmin) || t > tmax {
+        if t.is_nan() || t < tmin || t > tmax {
             return None;
         }
         Some(TriangleHit { t, u: v / det, v: w / det })

@@ -30,6 +30,10 @@ impl<K: Key> ParentSiblingState<K> {
         q: &mut QueryState,
         obs: &mut O,
     ) -> Step {
+        // Only damaged tables lead to an absent node; end rather than read out of bounds.
+        if self.addr.is_none() {
+            return Step::Done;
+        }
         obs.node(self.addr);
         let links = if !self.addr.is_leaf() {
             let node = mem.node(self.addr.index());
@@ -65,6 +69,9 @@ impl<K: Key> ParentSiblingState<K> {
         let mut levels = 0;
         while (self.trail & K::ONE).is_zero() {
             let parent = links[0];
+            if parent.is_none() || parent.is_leaf() {
+                return Step::Done;
+            }
             obs.link_read(parent);
             links = mem.node(parent.index()).links;
             self.trail = self.trail.shr(1);

@@ -61,6 +61,9 @@ impl Fallback for UncleHops {
         let (mut have, mut rest) = (*links, levels);
         while rest > known {
             let via = have[known as usize - 1];
+            if via.is_none() {
+                return NodeRef::NONE;
+            }
             rest -= known;
             obs.link_read(via);
             let [a, b] = mem.hop_links(via);
@@ -133,6 +136,10 @@ impl<K: Key, F: Fallback, const DISJOINT: bool> RegisterState<K, F, DISJOINT> {
         q: &mut QueryState,
         obs: &mut O,
     ) -> Step {
+        // Only damaged tables lead to an absent node; end rather than read out of bounds.
+        if self.addr.is_none() {
+            return Step::Done;
+        }
         obs.node(self.addr);
         if !self.addr.is_leaf() {
             let node = mem.node(self.addr.index());

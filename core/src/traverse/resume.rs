@@ -1,5 +1,6 @@
 use super::{PerfectHashLookup, QueryState, RegisterState, Step};
-use crate::bvh2::{BvhMemory, NodeRef};
+use super::TraceRoot;
+use crate::bvh2::BvhMemory;
 use crate::hash::lookup;
 use crate::intersect::{RayContext, TriangleTest};
 use crate::key::{self, Key};
@@ -47,13 +48,13 @@ fn ones_below<K: Key>(n: u32) -> K {
 #[inline]
 pub fn trace_pausing<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
     mem: &M,
-    root: NodeRef,
+    root: TraceRoot,
     ctx: &RayContext<T>,
     q: &mut QueryState,
     obs: &mut O,
 ) {
-    let mut state = RegisterState::<K, PerfectHashLookup, false>::new(root);
-    loop {
+    let mut state = RegisterState::<K, PerfectHashLookup, false>::new(root.node);
+    for _ in 0..=root.max_steps {
         match state.step(mem, ctx, q, obs) {
             Step::Continue => {}
             Step::Done => return,

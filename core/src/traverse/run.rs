@@ -15,6 +15,9 @@ pub struct TraceRoot {
     pub node: NodeRef,
     /// The largest coordinate magnitude in the scene (for [`RayContext::new`]).
     pub scene_scale: f32,
+    /// Steps after which traversal stops: the node count, since no method visits a node twice.
+    /// It never binds on intact tables; on damaged ones it guarantees termination.
+    pub max_steps: u32,
 }
 
 /// Traces one ray with `method` over `mem` (which must hold what the method needs: the
@@ -40,7 +43,10 @@ pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
     macro_rules! drive {
         ($state:expr) => {{
             let mut s = $state;
-            while s.step(mem, &ctx, &mut q, obs) != Step::Done {}
+            let mut budget = root.max_steps;
+            while s.step(mem, &ctx, &mut q, obs) != Step::Done && budget > 0 {
+                budget -= 1;
+            }
         }};
     }
     match method {
@@ -50,7 +56,7 @@ pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
         Method::Uncle => drive!(RegisterState::<K, UncleHops, false>::new(r)),
         Method::Hash => drive!(RegisterState::<K, PerfectHashLookup, false>::new(r)),
         Method::HashDisjoint => drive!(RegisterState::<K, PerfectHashLookup, true>::new(r)),
-        Method::HashResume => trace_pausing::<K, M, T, O>(mem, r, &ctx, &mut q, obs),
+        Method::HashResume => trace_pausing::<K, M, T, O>(mem, root, &ctx, &mut q, obs),
     }
     q.hit
 }

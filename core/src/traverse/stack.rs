@@ -36,6 +36,10 @@ impl<const DISJOINT: bool> StackState<DISJOINT> {
         q: &mut QueryState,
         obs: &mut O,
     ) -> Step {
+        // Only damaged tables lead to an absent node; end rather than read out of bounds.
+        if self.addr.is_none() {
+            return Step::Done;
+        }
         obs.node(self.addr);
         if !self.addr.is_leaf() {
             let node = mem.node(self.addr.index());

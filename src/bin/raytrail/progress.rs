@@ -31,7 +31,7 @@ impl Progress {
             return;
         }
         let width = 30;
-        let filled = if self.total == 0 { width } else { width * self.done / self.total };
+        let filled = (width * self.done).checked_div(self.total).unwrap_or(width).min(width);
         eprint!(
             "\r\x1b[2K{} [{}{}] {}/{} {:.1}s {}",
             self.label,

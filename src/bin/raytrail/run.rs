@@ -16,6 +16,9 @@ use std::sync::Arc;
 
 const FLAGS: &[&str] = &["scene", "builder", "width", "height", "passes", "threads", "check-rays"];
 
+/// One method's figures on a ray set: median seconds and counters.
+type Row = (Method, f64, Counters);
+
 struct RaySetRun {
     name: &'static str,
     query: Query,
@@ -145,9 +148,12 @@ fn per_ray(x: u64, c: &Counters) -> f64 {
     x as f64 / c.rays.max(1) as f64
 }
 
-fn print_table(set: &RaySetRun, rows: &[(Method, f64, Counters)], checked: usize, mismatches: &[Mismatch], depth: u32, key_bytes: usize) {
+fn print_table(set: &RaySetRun, rows: &[Row], checked: usize, mismatches: &[Mismatch], depth: u32, key_bytes: usize) {
     println!("\n{} rays: {} ({} hit), median of timed passes; conformance on {} rays", set.name, set.rays.len(), set.query.name(), checked);
-    println!("  {:<15} {:>9} {:>10} {:>10} {:>12} {:>10} {:>10} {:>8}  {}", "method", "Mrays/s", "vs stack", "nodes/ray", "backtr./ray", "hash/ray", "links/ray", "state B", "conformance");
+    println!(
+        "  {:<15} {:>9} {:>10} {:>10} {:>12} {:>10} {:>10} {:>8}  conformance",
+        "method", "Mrays/s", "vs stack", "nodes/ray", "backtr./ray", "hash/ray", "links/ray", "state B"
+    );
     let stack_s = rows.iter().find(|r| r.0 == Method::Stack).map_or(0.0, |r| r.1);
     for (m, secs, c) in rows {
         let bad = mismatches.iter().filter(|x| x.method == *m).count();
@@ -166,7 +172,7 @@ fn print_table(set: &RaySetRun, rows: &[(Method, f64, Counters)], checked: usize
     }
 }
 
-fn print_backtracking(sets: &[(&str, Vec<(Method, f64, Counters)>)]) {
+fn print_backtracking(sets: &[(&str, Vec<Row>)]) {
     println!("\nbacktracking steps of the hash method (Binder & Keller 2016, Fig. 3), share of all steps:");
     println!("  {:<9} {:>10} {:>10} {:>10} {:>11} {:>10} {:>10}   levels climbed 0..6, 7+", "rays", "postponed", "uncle", "g-uncle", "gg-uncle", "hash", "direct");
     for (name, rows) in sets {
