@@ -138,7 +138,12 @@ pub fn trace_all<B: Trace>(
     methods
         .iter()
         .map(|&method| {
-            let opts = TraceOptions { method, query, triangle_test: TriangleTestKind::Watertight, record: Record::Enumerations };
+            let opts = TraceOptions {
+                method,
+                query,
+                triangle_test: TriangleTestKind::Watertight,
+                record: Record::Enumerations,
+            };
             let mut hits = vec![Hit::MISS; rays.len()];
             let report = backend.trace(scene, rays, &opts, &mut hits)?;
             Ok(Outcome { method, query, hits, enumerations: report.enumerations })

@@ -99,7 +99,8 @@ impl BvhMemory for Tally<'_> {
 
 /// The hash cell and the direct displacement entry the hash method reads most often.
 fn busiest(prepared: &PreparedBvh2, rays: &[Ray]) -> (u32, u32) {
-    let tally = Tally { inner: prepared.memory(Method::Hash).unwrap(), cells: Default::default(), direct: Default::default() };
+    let tally =
+        Tally { inner: prepared.memory(Method::Hash).unwrap(), cells: Default::default(), direct: Default::default() };
     let root = prepared.root(Method::Hash).unwrap();
     for r in rays {
         trace_ray::<u32, _, Watertight, _>(Method::Hash, &tally, root, r, Query::Closest, &mut NoObserver);

@@ -66,14 +66,20 @@ impl fmt::Display for Error {
                 write!(f, "triangle {triangle} references vertex {index}, but there are only {vertex_count} vertices")
             }
             Error::NonFiniteVertex { vertex } => write!(f, "vertex {vertex} has a NaN or infinite coordinate"),
-            Error::TreeTooDeep { depth } => write!(f, "tree depth {depth} exceeds the 63 levels that 64-bit keys allow"),
-            Error::TreeTooLarge { what, size } => write!(f, "{what} ({size}) exceeds the 2^30 addresses node references allow"),
+            Error::TreeTooDeep { depth } => {
+                write!(f, "tree depth {depth} exceeds the 63 levels that 64-bit keys allow")
+            }
+            Error::TreeTooLarge { what, size } => {
+                write!(f, "{what} ({size}) exceeds the 2^30 addresses node references allow")
+            }
             Error::MalformedTree(why) => write!(f, "malformed tree: {why}"),
             Error::HashConstruction { keys, table_size } => {
                 write!(f, "no perfect hash for {keys} keys up to table size {table_size}")
             }
             Error::BufferMismatch { rays, hits } => write!(f, "{rays} rays but {hits} hit slots"),
-            Error::NotPrepared { method, missing } => write!(f, "method {method} needs {missing}, which the scene was not prepared with"),
+            Error::NotPrepared { method, missing } => {
+                write!(f, "method {method} needs {missing}, which the scene was not prepared with")
+            }
         }
     }
 }

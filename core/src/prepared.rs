@@ -67,7 +67,8 @@ impl PreparedBvh2 {
         let mut timings = PrepareTimings::default();
         let t0 = seconds_since(None);
         let needs_uncles = methods.iter().any(|m| !m.needs_parent_links());
-        let uncles = if needs_uncles { Some(BinaryLayout::new(&bvh, tris, LinkKind::Uncles)) } else { None }.transpose()?;
+        let uncles =
+            if needs_uncles { Some(BinaryLayout::new(&bvh, tris, LinkKind::Uncles)) } else { None }.transpose()?;
         let parents = if methods.iter().any(|m| m.needs_parent_links()) {
             Some(BinaryLayout::new(&bvh, tris, LinkKind::ParentSibling)).transpose()?
         } else {
@@ -86,7 +87,8 @@ impl PreparedBvh2 {
         let hash = if methods.iter().any(|m| m.needs_hash()) { Some(build(HashCoverage::Backtracking)?) } else { None };
         timings.hash = seconds_since(Some(t1));
         let t2 = seconds_since(None);
-        let full_hash = if methods.iter().any(|m| m.needs_full_hash()) { Some(build(HashCoverage::All)?) } else { None };
+        let full_hash =
+            if methods.iter().any(|m| m.needs_full_hash()) { Some(build(HashCoverage::All)?) } else { None };
         timings.full_hash = seconds_since(Some(t2));
         Ok(PreparedBvh2 { bvh, uncles, parents, hash, full_hash, timings })
     }
@@ -110,7 +112,11 @@ impl PreparedBvh2 {
     pub fn memory(&self, method: Method) -> Result<SliceMemory<'_>, Error> {
         let layout = self.layout(method)?;
         let hash = if method.needs_full_hash() {
-            Some(self.full_hash.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "the full hash" })?)
+            Some(
+                self.full_hash
+                    .as_ref()
+                    .ok_or(Error::NotPrepared { method: method.name(), missing: "the full hash" })?,
+            )
         } else if method.needs_hash() {
             Some(self.hash.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "the hash tables" })?)
         } else {

@@ -82,6 +82,11 @@ pub trait Trace {
     /// Makes a prepared scene usable by this backend.
     fn prepare(&self, scene: Arc<PreparedBvh2>) -> Result<Self::Prepared, Error>;
     /// Traces `rays` into `hits` (same length), recording what `options` ask for.
-    fn trace(&self, scene: &Self::Prepared, rays: &[Ray], options: &TraceOptions, hits: &mut [Hit])
-        -> Result<Report, Error>;
+    fn trace(
+        &self,
+        scene: &Self::Prepared,
+        rays: &[Ray],
+        options: &TraceOptions,
+        hits: &mut [Hit],
+    ) -> Result<Report, Error>;
 }

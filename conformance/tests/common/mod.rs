@@ -24,7 +24,10 @@ pub fn mesh(file: &str) -> Option<NamedScene> {
             eprintln!("SKIPPED {file}: {e} ({ALLOW_MISSING}=1)");
             None
         }
-        Err(e) => panic!("{e}\n(scenes are read from {}; set RAYTRAIL_SCENES or run the fetch script)", scenes_dir().display()),
+        Err(e) => panic!(
+            "{e}\n(scenes are read from {}; set RAYTRAIL_SCENES or run the fetch script)",
+            scenes_dir().display()
+        ),
     }
 }
 

@@ -81,7 +81,11 @@ impl BinaryLayout {
                 LinkKind::Uncles => [ancestor_sibling(i, 1), ancestor_sibling(i, 2), ancestor_sibling(i, 3)],
                 LinkKind::ParentSibling => {
                     let p = parents[i];
-                    [if p == u32::MAX { NodeRef::NONE } else { refs[p as usize] }, ancestor_sibling(i, 0), NodeRef::NONE]
+                    [
+                        if p == u32::MAX { NodeRef::NONE } else { refs[p as usize] },
+                        ancestor_sibling(i, 0),
+                        NodeRef::NONE,
+                    ]
                 }
             }
         };
@@ -101,7 +105,9 @@ impl BinaryLayout {
                     leaf_ids[leaves.len()] = i as u32;
                     let prims = &bvh.prim_order()[first as usize..(first + count) as usize];
                     for (j, &p) in prims.iter().enumerate() {
-                        let t = triangles.get(p as usize).ok_or(Error::MalformedTree("primitive id beyond the triangles"))?;
+                        let t = triangles
+                            .get(p as usize)
+                            .ok_or(Error::MalformedTree("primitive id beyond the triangles"))?;
                         // The free slots of the first triangle's second and third entries carry the
                         // first two links, so iterative backtracking can hop over a leaf without
                         // searching for its terminator (Binder & Keller 2016, Sec. 2.2, side note).

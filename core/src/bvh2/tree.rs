@@ -72,7 +72,8 @@ impl Bvh2 {
         let mut seen = alloc::vec![false; nodes.len()];
         let mut prim_seen = alloc::vec![false; prim_order.len()];
         let mut new_order: Vec<u32> = Vec::with_capacity(prim_order.len());
-        let mut stats = TreeStats { internal_nodes: 0, leaves: 0, depth: 0, max_leaf_size: 0, key_width: KeyWidth::W32 };
+        let mut stats =
+            TreeStats { internal_nodes: 0, leaves: 0, depth: 0, max_leaf_size: 0, key_width: KeyWidth::W32 };
         let mut todo: Vec<Pending> = alloc::vec![(root, 0, None)];
         while let Some((old, depth, patch)) = todo.pop() {
             let node = nodes.get(old as usize).ok_or(Error::MalformedTree("child index out of range"))?;
@@ -92,7 +93,10 @@ impl Bvh2 {
             match node.kind {
                 NodeKind::Internal { left, right } => {
                     stats.internal_nodes += 1;
-                    out.push(Bvh2Node { bounds: node.bounds, kind: NodeKind::Internal { left: u32::MAX, right: u32::MAX } });
+                    out.push(Bvh2Node {
+                        bounds: node.bounds,
+                        kind: NodeKind::Internal { left: u32::MAX, right: u32::MAX },
+                    });
                     let slot = out.len() - 1;
                     // Right pushed first so the left subtree is numbered first (pre-order).
                     todo.push((right, depth + 1, Some((slot, true))));
@@ -107,7 +111,8 @@ impl Bvh2 {
                     }
                     let start = new_order.len() as u32;
                     for &p in range {
-                        let s = prim_seen.get_mut(p as usize).ok_or(Error::MalformedTree("primitive id out of range"))?;
+                        let s =
+                            prim_seen.get_mut(p as usize).ok_or(Error::MalformedTree("primitive id out of range"))?;
                         if core::mem::replace(s, true) {
                             return Err(Error::MalformedTree("a primitive is referenced twice"));
                         }

@@ -86,6 +86,7 @@ impl PerfectHash {
             let mut cells = alloc::vec![NodeRef::NONE.0; h as usize];
             let mut direct = 0;
             let mut slots: Vec<u64> = Vec::new();
+            let mut bases: Vec<u64> = Vec::new();
             for &b in &order {
                 let bucket = &members[start[b as usize]..start[b as usize + 1]];
                 if let [(_, addr)] = bucket {
@@ -93,11 +94,18 @@ impl PerfectHash {
                     direct += 1;
                     continue;
                 }
+                // `(k + d) mod H` as `(k mod H + d) mod H`: one division per key, not per probe.
+                bases.clear();
+                bases.extend(bucket.iter().map(|&(k, _)| k % h));
+                // Buckets start their search at spread-out displacements rather than all at 0,
+                // which would crowd the cells just past each key's home slot.
+                let first = (b as u64).wrapping_mul(0x9E37_79B9) % h;
                 let mut placed = false;
-                for d in 0..h {
+                for i in 0..h {
+                    let d = if first + i >= h { first + i - h } else { first + i };
                     slots.clear();
-                    let fits = bucket.iter().all(|&(k, _)| {
-                        let s = (k + d) % h;
+                    let fits = bases.iter().all(|&base| {
+                        let s = if base + d >= h { base + d - h } else { base + d };
                         let free = cells[s as usize] == NodeRef::NONE.0 && !slots.contains(&s);
                         slots.push(s);
                         free
@@ -167,7 +175,12 @@ mod tests {
     fn every_key_maps_to_its_address() {
         // Keys spread like those of an unbalanced tree, addresses mixing internal nodes and leaves.
         let entries: Vec<(u64, NodeRef)> = (1..1500u64)
-            .map(|i| (i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 30, if i % 3 == 0 { NodeRef::leaf(i as u32 * 7) } else { NodeRef::internal(i as u32) }))
+            .map(|i| {
+                (
+                    i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 30,
+                    if i % 3 == 0 { NodeRef::leaf(i as u32 * 7) } else { NodeRef::internal(i as u32) },
+                )
+            })
             .collect();
         let s = check(&entries, 4000);
         assert_eq!(s.keys, 1499);
@@ -178,7 +191,8 @@ mod tests {
 
     #[test]
     fn deep_keys_and_tiny_trees() {
-        let deep: Vec<(u64, NodeRef)> = (0..500u64).map(|i| ((1u64 << 60) | (i * 0x9E37_79B9), NodeRef::internal(i as u32))).collect();
+        let deep: Vec<(u64, NodeRef)> =
+            (0..500u64).map(|i| ((1u64 << 60) | (i * 0x9E37_79B9), NodeRef::internal(i as u32))).collect();
         check(&deep, 600);
         check(&[(2, NodeRef::leaf(0)), (3, NodeRef::leaf(4))], 3);
         check(&[], 1);

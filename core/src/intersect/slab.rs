@@ -41,16 +41,16 @@ impl SlabRay {
     ///
     /// Near and far planes are picked by the direction's sign bit, so a `±0` component yields
     /// `±inf` distances rather than swapping planes. A `0 * inf` NaN (origin on a plane of a slab
-    /// the ray runs parallel to) is ignored by `f32::max`/`f32::min`, which return the non-NaN
-    /// operand: the accumulators start from `tmin`/`tmax`, which are never NaN for a traceable
-    /// ray, so a NaN never turns a hit into a miss.
+    /// the ray runs parallel to) is ignored by [`keep_max`]/[`keep_min`], which keep the
+    /// accumulator when the candidate is NaN: the accumulators start from `tmin`/`tmax`, never NaN
+    /// for a traceable ray, so a NaN never turns a hit into a miss.
     #[inline(always)]
     pub fn hit(&self, lo: Vec3, hi: Vec3, tmin: f32, tmax: f32) -> Option<BoxHit> {
         let (near, far) = self.planes(lo, hi);
         let tn = (near - self.origin) * self.inv_dir;
         let tf = (far - self.origin) * self.inv_dir * FAR_PAD;
-        let t_enter = tmin.max(tn.x).max(tn.y).max(tn.z);
-        let t_exit = tmax.min(tf.x).min(tf.y).min(tf.z);
+        let t_enter = keep_max(keep_max(keep_max(tmin, tn.x), tn.y), tn.z);
+        let t_exit = keep_min(keep_min(keep_min(tmax, tf.x), tf.y), tf.z);
         (t_enter <= t_exit).then_some(BoxHit { t_enter, t_exit })
     }
 
@@ -61,6 +61,27 @@ impl SlabRay {
         let (ny, fy) = pick(self.negative[1], lo.y, hi.y);
         let (nz, fz) = pick(self.negative[2], lo.z, hi.z);
         (Vec3::new(nx, ny, nz), Vec3::new(fx, fy, fz))
+    }
+}
+
+/// `max(acc, x)`, keeping `acc` when `x` is NaN or equal. One `maxss` on x86 (`f32::max` needs
+/// several instructions to treat NaN in either operand); a shader writes `select(acc, x, x > acc)`.
+#[inline(always)]
+pub fn keep_max(acc: f32, x: f32) -> f32 {
+    if x > acc {
+        x
+    } else {
+        acc
+    }
+}
+
+/// `min(acc, x)`, keeping `acc` when `x` is NaN or equal; see [`keep_max`].
+#[inline(always)]
+pub fn keep_min(acc: f32, x: f32) -> f32 {
+    if x < acc {
+        x
+    } else {
+        acc
     }
 }
 
@@ -86,6 +107,14 @@ mod tests {
     fn axis_parallel_ray_outside_misses() {
         assert!(ray([2.0, -1.0, 0.5], [0.0, 1.0, 0.0]).hit(Vec3::ZERO, Vec3::ONE, 0.0, f32::INFINITY).is_none());
         assert!(ray([-0.5, -1.0, 0.5], [-0.0, 1.0, 0.0]).hit(Vec3::ZERO, Vec3::ONE, 0.0, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn nan_candidates_are_ignored() {
+        assert_eq!(keep_max(1.0, f32::NAN), 1.0);
+        assert_eq!(keep_min(1.0, f32::NAN), 1.0);
+        assert_eq!(keep_max(1.0, 2.0), 2.0);
+        assert_eq!(keep_min(1.0, 0.5), 0.5);
     }
 
     #[test]

@@ -1,5 +1,5 @@
 use crate::bvh2::BinaryNode;
-use crate::intersect::{SlabRay, TriangleTest, RayContext};
+use crate::intersect::{RayContext, SlabRay, TriangleTest};
 
 /// Where traversal goes from an internal node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,5 +1,5 @@
-use super::{PerfectHashLookup, QueryState, RegisterState, Step};
 use super::TraceRoot;
+use super::{PerfectHashLookup, QueryState, RegisterState, Step};
 use crate::bvh2::BvhMemory;
 use crate::hash::lookup;
 use crate::intersect::{RayContext, TriangleTest};

@@ -13,7 +13,8 @@ impl Args {
         let mut values = HashMap::new();
         let mut it = args.iter();
         while let Some(a) = it.next() {
-            let name = a.strip_prefix("--").ok_or_else(|| format!("unexpected argument '{a}' (flags start with --)"))?;
+            let name =
+                a.strip_prefix("--").ok_or_else(|| format!("unexpected argument '{a}' (flags start with --)"))?;
             if switches.contains(&name) {
                 values.insert(name.to_string(), None);
             } else {
@@ -27,7 +28,10 @@ impl Args {
     /// Rejects flags outside `known`.
     pub fn only(&self, known: &[&str]) -> Result<(), String> {
         match self.values.keys().find(|k| !known.contains(&k.as_str())) {
-            Some(k) => Err(format!("unknown flag --{k}; known: {}", known.iter().map(|k| format!("--{k}")).collect::<Vec<_>>().join(" "))),
+            Some(k) => Err(format!(
+                "unknown flag --{k}; known: {}",
+                known.iter().map(|k| format!("--{k}")).collect::<Vec<_>>().join(" ")
+            )),
             None => Ok(()),
         }
     }

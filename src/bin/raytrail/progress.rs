@@ -15,7 +15,13 @@ pub struct Progress {
 impl Progress {
     /// Starts a display for `total` steps.
     pub fn new(label: &str, total: usize) -> Self {
-        let p = Progress { label: label.to_string(), total, done: 0, start: Instant::now(), tty: std::io::stderr().is_terminal() };
+        let p = Progress {
+            label: label.to_string(),
+            total,
+            done: 0,
+            start: Instant::now(),
+            tty: std::io::stderr().is_terminal(),
+        };
         p.draw("");
         p
     }

@@ -41,13 +41,13 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     let (named, _) = timed(&format!("loading {scene_arg}"), || load_scene(scene_arg));
     let named = named?;
     let scene = &named.scene;
-    let (bvh, build_s) = timed(&format!("building the BVH2 ({}, {} triangles)", builder.name(), scene.triangles().len()), || {
-        builder.build(scene)
-    });
+    let (bvh, build_s) =
+        timed(&format!("building the BVH2 ({}, {} triangles)", builder.name(), scene.triangles().len()), || {
+            builder.build(scene)
+        });
     let bvh = bvh.map_err(|e| e.to_string())?;
-    let (prepared, _) = timed("deriving layouts and hash tables for every method", || {
-        PreparedBvh2::new(scene, bvh, &Method::ALL)
-    });
+    let (prepared, _) =
+        timed("deriving layouts and hash tables for every method", || PreparedBvh2::new(scene, bvh, &Method::ALL));
     let prepared = Arc::new(prepared.map_err(|e| e.to_string())?);
     print_scene(&named.name, builder, build_s, &prepared);
 
@@ -61,7 +61,12 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     for set in &sets {
         let mut rows = Vec::new();
         for method in Method::ALL {
-            let mut opts = TraceOptions { method, query: set.query, triangle_test: TriangleTestKind::Watertight, record: Record::Nothing };
+            let mut opts = TraceOptions {
+                method,
+                query: set.query,
+                triangle_test: TriangleTestKind::Watertight,
+                record: Record::Nothing,
+            };
             let mut hits = vec![Hit::MISS; set.rays.len()];
             let mut times = Vec::with_capacity(passes);
             for _ in 0..passes {
@@ -89,7 +94,9 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     }
     print_backtracking(&tables.iter().map(|(s, rows, ..)| (s.name, rows.clone())).collect::<Vec<_>>());
     if failures.is_empty() {
-        println!("\nconformance: every method matches its reference on every checked ray (hits and node enumerations).");
+        println!(
+            "\nconformance: every method matches its reference on every checked ray (hits and node enumerations)."
+        );
         Ok(0)
     } else {
         println!("\nCONFORMANCE FAILED: {} mismatches. The first ones:", failures.len());
@@ -105,7 +112,13 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
-fn ray_sets(backend: &CpuBackend, cpu: &CpuScene, scene: &raytrail::core::scene::Scene, w: u32, h: u32) -> Result<Vec<RaySetRun>, String> {
+fn ray_sets(
+    backend: &CpuBackend,
+    cpu: &CpuScene,
+    scene: &raytrail::core::scene::Scene,
+    w: u32,
+    h: u32,
+) -> Result<Vec<RaySetRun>, String> {
     let prim = primary(scene, w, h);
     let mut hits = vec![Hit::MISS; prim.len()];
     backend.trace(cpu, &prim, &TraceOptions::new(Method::Stack), &mut hits).map_err(|e| e.to_string())?;
@@ -125,11 +138,26 @@ fn mb(bytes: usize) -> f64 {
 
 fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedBvh2) {
     let s = p.bvh.stats();
-    println!("\nscene {name}: {} internal nodes, {} leaves (largest {}), depth {}, {} keys (the {} path)",
-        s.internal_nodes, s.leaves, s.max_leaf_size, s.depth, s.key_width,
-        if s.key_width == raytrail::core::key::KeyWidth::W32 { "fast 32-bit" } else { "64-bit, as the depth exceeds 31" });
-    println!("  BVH2 ({}) built in {:.3} s; layouts {:.1} MB (nodes and leaf triangles) in {:.1} ms",
-        builder.name(), build_s, mb(p.bvh_bytes()), 1e3 * p.timings.layouts);
+    println!(
+        "\nscene {name}: {} internal nodes, {} leaves (largest {}), depth {}, {} keys (the {} path)",
+        s.internal_nodes,
+        s.leaves,
+        s.max_leaf_size,
+        s.depth,
+        s.key_width,
+        if s.key_width == raytrail::core::key::KeyWidth::W32 {
+            "fast 32-bit"
+        } else {
+            "64-bit, as the depth exceeds 31"
+        }
+    );
+    println!(
+        "  BVH2 ({}) built in {:.3} s; layouts {:.1} MB (nodes and leaf triangles) in {:.1} ms",
+        builder.name(),
+        build_s,
+        mb(p.bvh_bytes()),
+        1e3 * p.timings.layouts
+    );
     let describe = |label: &str, h: &Option<BuiltHash>, secs: f64| {
         if let Some(h) = h {
             let st = &h.stats;
@@ -149,7 +177,13 @@ fn per_ray(x: u64, c: &Counters) -> f64 {
 }
 
 fn print_table(set: &RaySetRun, rows: &[Row], checked: usize, mismatches: &[Mismatch], depth: u32, key_bytes: usize) {
-    println!("\n{} rays: {} ({} hit), median of timed passes; conformance on {} rays", set.name, set.rays.len(), set.query.name(), checked);
+    println!(
+        "\n{} rays: {} ({} hit), median of timed passes; conformance on {} rays",
+        set.name,
+        set.rays.len(),
+        set.query.name(),
+        checked
+    );
     println!(
         "  {:<15} {:>9} {:>10} {:>10} {:>12} {:>10} {:>10} {:>8}  conformance",
         "method", "Mrays/s", "vs stack", "nodes/ray", "backtr./ray", "hash/ray", "links/ray", "state B"
@@ -174,7 +208,10 @@ fn print_table(set: &RaySetRun, rows: &[Row], checked: usize, mismatches: &[Mism
 
 fn print_backtracking(sets: &[(&str, Vec<Row>)]) {
     println!("\nbacktracking steps of the hash method (Binder & Keller 2016, Fig. 3), share of all steps:");
-    println!("  {:<9} {:>10} {:>10} {:>10} {:>11} {:>10} {:>10}   levels climbed 0..6, 7+", "rays", "postponed", "uncle", "g-uncle", "gg-uncle", "hash", "direct");
+    println!(
+        "  {:<9} {:>10} {:>10} {:>10} {:>11} {:>10} {:>10}   levels climbed 0..6, 7+",
+        "rays", "postponed", "uncle", "g-uncle", "gg-uncle", "hash", "direct"
+    );
     for (name, rows) in sets {
         let Some((_, _, c)) = rows.iter().find(|r| r.0 == Method::Hash) else { continue };
         let total = c.backtracks.max(1) as f64;
@@ -182,8 +219,14 @@ fn print_backtracking(sets: &[(&str, Vec<Row>)]) {
         let levels: Vec<String> = c.levels.iter().map(|&l| format!("{:.0}", 100.0 * l as f64 / total)).collect();
         println!(
             "  {:<9} {:>10} {:>10} {:>10} {:>11} {:>10} {:>10}   {}%",
-            name, pct(c.register[0]), pct(c.register[1]), pct(c.register[2]), pct(c.register[3]),
-            pct(c.hash[0]), pct(c.hash[1]), levels.join(" ")
+            name,
+            pct(c.register[0]),
+            pct(c.register[1]),
+            pct(c.register[2]),
+            pct(c.register[3]),
+            pct(c.hash[0]),
+            pct(c.hash[1]),
+            levels.join(" ")
         );
     }
     println!("  (register: postponed = stored on postponing; uncle, g-uncle, gg-uncle = loaded from links; hash: through the table; direct: from the displacement entry)");

@@ -24,13 +24,18 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     let out = a.required("out")?;
     let rays = npy::read_rays(rays_path).map_err(|e| e.to_string())?;
     let (bvh, _) = timed("building the BVH2", || builder.build(&named.scene));
-    let prepared = PreparedBvh2::new(&named.scene, bvh.map_err(|e| e.to_string())?, &[method]).map_err(|e| e.to_string())?;
+    let prepared =
+        PreparedBvh2::new(&named.scene, bvh.map_err(|e| e.to_string())?, &[method]).map_err(|e| e.to_string())?;
     let backend = CpuBackend::new();
     let scene = backend.prepare(Arc::new(prepared)).map_err(|e| e.to_string())?;
     let opts = TraceOptions {
         method,
         query: if a.has("any") { Query::Any } else { Query::Closest },
-        triangle_test: if a.has("moller-trumbore") { TriangleTestKind::MollerTrumbore } else { TriangleTestKind::Watertight },
+        triangle_test: if a.has("moller-trumbore") {
+            TriangleTestKind::MollerTrumbore
+        } else {
+            TriangleTestKind::Watertight
+        },
         record: Record::Nothing,
     };
     let mut hits = vec![Hit::MISS; rays.len()];

@@ -1,0 +1,101 @@
+//! The command line end to end: `rays` writes a NumPy ray file, `trace` reads it and writes hits
+//! that match tracing the same rays through the library; bad input gives an error, not a panic.
+
+use raytrail::conformance::paths::mesh_path;
+use raytrail::core::prepared::PreparedBvh2;
+use raytrail::core::trace::{Trace, TraceOptions};
+use raytrail::core::traverse::Method;
+use raytrail::core::Hit;
+use raytrail::cpu::{npy, CpuBackend};
+use raytrail::{load_scene, Builder};
+use std::path::PathBuf;
+use std::process::Command;
+use std::sync::Arc;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_raytrail"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("raytrail-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn rays_then_trace_matches_the_library() {
+    let scene = mesh_path("cornell_box.obj");
+    if !scene.exists() && std::env::var("RAYTRAIL_ALLOW_MISSING_SCENES").as_deref() == Ok("1") {
+        eprintln!("SKIPPED: {} is missing", scene.display());
+        return;
+    }
+    let (rays, hits) = (tmp("rays.npy"), tmp("hits.npy"));
+    let out = bin()
+        .args(["rays", "--scene"])
+        .arg(&scene)
+        .arg("--out")
+        .arg(&rays)
+        .args(["--width", "40", "--height", "30"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for method in ["stack", "hash", "hash-resume"] {
+        let out = bin()
+            .args(["trace", "--scene"])
+            .arg(&scene)
+            .arg("--rays")
+            .arg(&rays)
+            .args(["--method", method, "--out"])
+            .arg(&hits)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let got = npy::read_hits(&hits).unwrap();
+        let ray_list = npy::read_rays(&rays).unwrap();
+        assert_eq!(got.len(), 1200);
+        let named = load_scene(scene.to_str().unwrap()).unwrap();
+        let bvh = Builder::Sah.build(&named.scene).unwrap();
+        let prepared = PreparedBvh2::new(&named.scene, bvh, &[Method::Stack]).unwrap();
+        let backend = CpuBackend::new();
+        let cpu = backend.prepare(Arc::new(prepared)).unwrap();
+        let mut expected = vec![Hit::MISS; ray_list.len()];
+        backend.trace(&cpu, &ray_list, &TraceOptions::new(Method::Stack), &mut expected).unwrap();
+        assert!(got.iter().zip(&expected).all(|(a, b)| a.same_as(b)), "{method}: hits differ from the library's");
+        assert!(got.iter().any(Hit::is_hit) && got.iter().any(|h| !h.is_hit()));
+    }
+}
+
+#[test]
+fn bad_input_is_an_error_not_a_panic() {
+    let bad = tmp("bad.npy");
+    std::fs::write(&bad, b"not a numpy file").unwrap();
+    let cases: Vec<Vec<String>> = vec![
+        vec![
+            "trace".into(),
+            "--scene".into(),
+            "builtin".into(),
+            "--rays".into(),
+            bad.display().to_string(),
+            "--out".into(),
+            "x.npy".into(),
+        ],
+        vec![
+            "trace".into(),
+            "--scene".into(),
+            "/nonexistent.obj".into(),
+            "--rays".into(),
+            "r.npy".into(),
+            "--out".into(),
+            "x".into(),
+        ],
+        vec!["trace".into(), "--scene".into(), "builtin".into(), "--method".into(), "nope".into()],
+        vec!["run".into(), "--width".into(), "many".into()],
+        vec!["frobnicate".into()],
+    ];
+    for args in cases {
+        let out = bin().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("error:") && !err.contains("panicked"), "{args:?}: {err}");
+    }
+}
