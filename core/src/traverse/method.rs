@@ -59,7 +59,9 @@ impl Method {
     }
 
     /// Per-ray traversal state in bytes, beyond the ray and its answer: the registers the paper
-    /// names, for a tree of the given depth and key width in bytes.
+    /// names, for a tree of the given depth and key width in bytes, as a hardware unit or a
+    /// shader sized for this tree would hold them. (The Rust state types are larger: the stack
+    /// is fixed at 64 entries so one type serves every tree.)
     pub fn state_bytes(self, depth: u32, key_bytes: usize) -> usize {
         let addr = 4;
         match self {
