@@ -1,4 +1,4 @@
-//! Criterion bench of the BVH2 methods a-d (and the other stackless variants) on real scenes.
+//! Criterion bench of the BVH2 methods a-d and the five kd-tree methods on real scenes.
 //!
 //! `cargo bench --bench traversal` traces the same primary and diffuse rays with every method on
 //! the CPU backend (all threads) and reports time per batch; compare methods side by side within
@@ -16,7 +16,17 @@ use raytrail::Builder;
 use std::sync::Arc;
 
 const SCENES: &[&str] = &["bunny.obj", "sponza.obj"];
-const METHODS: &[Method] = &[Method::Stack, Method::ParentSibling, Method::Uncle, Method::Hash];
+const METHODS: &[Method] = &[
+    Method::Stack,
+    Method::ParentSibling,
+    Method::Uncle,
+    Method::Hash,
+    Method::KdStack,
+    Method::KdRestart,
+    Method::KdPushDown,
+    Method::KdShortStack,
+    Method::KdPacket,
+];
 
 fn bench(c: &mut Criterion) {
     let backend = CpuBackend::new();

@@ -20,6 +20,7 @@ pub mod error;
 pub mod geometry;
 pub mod hash;
 pub mod intersect;
+pub mod kd;
 pub mod key;
 #[cfg(feature = "std")]
 pub mod mesh;

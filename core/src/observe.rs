@@ -34,6 +34,8 @@ pub enum Backtrack {
     },
     /// Iterating over parent and sibling links, or uncle links.
     Iterative,
+    /// Descending again from the root or a pushed-down node (kd-restart).
+    Restart,
 }
 
 /// Receives traversal events. Every hook defaults to doing nothing.
@@ -89,6 +91,8 @@ pub struct Counters {
     pub iterative: u64,
     /// Link reads made while iterating.
     pub link_reads: u64,
+    /// Restarts (kd methods).
+    pub restarts: u64,
     /// Histogram of levels climbed per backtracking step (0: sibling, ..., 7: seven or more).
     pub levels: [u64; 8],
 }
@@ -104,6 +108,7 @@ impl Counters {
         self.stack_pops += o.stack_pops;
         self.iterative += o.iterative;
         self.link_reads += o.link_reads;
+        self.restarts += o.restarts;
         for i in 0..4 {
             self.register[i] += o.register[i];
         }
@@ -148,6 +153,7 @@ impl Observer for Counters {
             Backtrack::Register(s) => self.register[s as usize] += 1,
             Backtrack::Hash { direct } => self.hash[direct as usize] += 1,
             Backtrack::Iterative => self.iterative += 1,
+            Backtrack::Restart => self.restarts += 1,
         }
     }
     #[inline(always)]

@@ -1,9 +1,13 @@
 //! A canonical tree with the layouts and tables its methods need, and nothing more.
 
 use crate::bvh2::{BinaryLayout, Bvh2, LinkKind, NodeRef, SliceMemory};
+use crate::geometry::Triangle;
 use crate::hash::{keys_to_hash, HashCoverage, HashShape, HashStats, PerfectHash};
+use crate::kd::traverse::KdRoot;
+use crate::kd::{KdBuilder, KdSliceMemory, KdTree};
 use crate::key::KeyWidth;
 use crate::scene::Scene;
+use crate::traverse::Family;
 use crate::traverse::{Method, TraceRoot};
 use crate::Error;
 use alloc::vec::Vec;
@@ -17,6 +21,19 @@ pub struct PrepareTimings {
     pub hash: f64,
     /// The hash over every node.
     pub full_hash: f64,
+    /// The kd-tree.
+    pub kd: f64,
+}
+
+/// A kd-tree with the triangles its leaves reference.
+#[derive(Clone, Debug)]
+pub struct PreparedKd {
+    /// The tree.
+    pub tree: KdTree,
+    /// The scene's triangles, by primitive id.
+    pub triangles: Vec<Triangle>,
+    /// Entries of the short stack (Horn et al. 2007 use 3).
+    pub short_stack: usize,
 }
 
 /// A perfect hash with its construction figures.
@@ -42,6 +59,8 @@ pub struct PreparedBvh2 {
     pub hash: Option<BuiltHash>,
     /// Hash over every node (method f).
     pub full_hash: Option<BuiltHash>,
+    /// The kd-tree (kd methods), built with [`KdBuilder::default`].
+    pub kd: Option<PreparedKd>,
     /// Time spent on each part.
     pub timings: PrepareTimings,
 }
@@ -90,7 +109,15 @@ impl PreparedBvh2 {
         let full_hash =
             if methods.iter().any(|m| m.needs_full_hash()) { Some(build(HashCoverage::All)?) } else { None };
         timings.full_hash = seconds_since(Some(t2));
-        Ok(PreparedBvh2 { bvh, uncles, parents, hash, full_hash, timings })
+        let t3 = seconds_since(None);
+        let kd = if methods.iter().any(|m| m.family() == Family::Kd) {
+            let tree = KdBuilder::default().build(tris)?;
+            Some(PreparedKd { tree, triangles: tris.to_vec(), short_stack: 3 })
+        } else {
+            None
+        };
+        timings.kd = seconds_since(Some(t3));
+        Ok(PreparedBvh2 { bvh, uncles, parents, hash, full_hash, kd, timings })
     }
 
     /// Key width the tree's depth needs.
@@ -136,6 +163,25 @@ impl PreparedBvh2 {
         let b = self.bvh.nodes()[0].bounds;
         let scene_scale = b.min.abs().max(b.max.abs()).max_element();
         Ok(TraceRoot { node: self.layout(method)?.root, scene_scale, max_steps: self.bvh.len() as u32 })
+    }
+
+    /// The kd-tree and triangles the kd methods read.
+    pub fn kd_memory(&self) -> Result<KdSliceMemory<'_>, Error> {
+        let kd = self.kd.as_ref().ok_or(Error::NotPrepared { method: "kd", missing: "the kd-tree" })?;
+        Ok(KdSliceMemory { nodes: kd.tree.nodes(), prims: kd.tree.prims(), triangles: &kd.triangles })
+    }
+
+    /// Where the kd methods start.
+    pub fn kd_root(&self) -> Result<KdRoot, Error> {
+        let kd = self.kd.as_ref().ok_or(Error::NotPrepared { method: "kd", missing: "the kd-tree" })?;
+        let b = kd.tree.bounds();
+        Ok(KdRoot {
+            lo: b.min,
+            hi: b.max,
+            scene_scale: b.min.abs().max(b.max.abs()).max_element(),
+            max_steps: (kd.tree.nodes().len() + 66 * kd.tree.stats().leaves).min(u32::MAX as usize) as u32,
+            short_stack: kd.short_stack,
+        })
     }
 
     /// Bytes of the uncle layout (the BVH the hash overhead is relative to).

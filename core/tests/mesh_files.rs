@@ -118,14 +118,16 @@ mod mesh {
 
     /// Loads `data` from a file named `file` in a scratch folder, removed afterwards.
     fn load_file(file: &str, data: &[u8]) -> (PathBuf, Result<Mesh, mesh::MeshError>) {
-        let dir = std::env::temp_dir().join(format!("raytrail-mesh-files-{}", std::process::id()));
+        // One folder per call: tests run in parallel, and a shared folder could be removed by one
+        // test while another writes into it.
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("raytrail-mesh-files-{}-{n}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join(file);
         std::fs::write(&path, data).unwrap();
         let result = load(&path);
-        std::fs::remove_file(&path).unwrap();
-        // Fails while other tests still have files there; the last one out removes it.
-        let _ = std::fs::remove_dir(&dir);
+        let _ = std::fs::remove_dir_all(&dir);
         (path, result)
     }
 

@@ -33,7 +33,7 @@ fn main() {
     assert!(stats.depth <= MAX_U32_DEPTH, "tree depth {} needs 64-bit keys; the example uses u32", stats.depth);
     // Every method: the stack methods and the stackless ones share the uncle layout; only
     // parent/sibling needs its own layout and only hash-resume the hash over every node.
-    let prepared = PreparedBvh2::new(&scene, bvh, &Method::ALL).expect("the sphereflake prepares");
+    let prepared = PreparedBvh2::new(&scene, bvh, &Method::BVH2).expect("the sphereflake prepares");
 
     let uncles = prepared.layout(Method::Uncle).expect("uncle layout prepared");
     let parents = prepared.layout(Method::ParentSibling).expect("parent/sibling layout prepared");
@@ -175,7 +175,7 @@ fn footprint(p: &PreparedBvh2, uncles: &BinaryLayout, parents: &BinaryLayout, ha
         warn(format!("{name}: displacement {d} B, cells {c} B"));
     }
     warn(format!("total tables in flash: {total} B"));
-    for m in Method::ALL {
+    for m in Method::BVH2 {
         warn(format!("per-ray state, {}: {} B", m.name(), m.state_bytes(s.depth, 4)));
     }
 }

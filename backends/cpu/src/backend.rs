@@ -3,6 +3,7 @@ use rayon::prelude::*;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedBvh2;
 use raytrail_core::trace::{Record, Report, Trace, TraceOptions};
+use raytrail_core::traverse::Family;
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 use std::time::Instant;
@@ -60,7 +61,10 @@ impl Trace for CpuBackend {
             return Err(Error::BufferMismatch { rays: rays.len(), hits: hits.len() });
         }
         // Fail before timing if the scene lacks what the method needs.
-        scene.0.memory(opts.method)?;
+        match opts.method.family() {
+            Family::Bvh2 => scene.0.memory(opts.method).map(|_| ())?,
+            Family::Kd => scene.0.kd_memory().map(|_| ())?,
+        }
         let mut enumerations: Vec<Vec<u32>> =
             if opts.record == Record::Enumerations { vec![Vec::new(); rays.len()] } else { Vec::new() };
         let start = Instant::now();

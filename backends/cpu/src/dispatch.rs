@@ -6,7 +6,7 @@ use raytrail_core::key::{Key, KeyWidth};
 use raytrail_core::observe::{Both, Counters, NoObserver, Recorder};
 use raytrail_core::prepared::PreparedBvh2;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
-use raytrail_core::traverse::{trace_ray, TraceRoot};
+use raytrail_core::traverse::{trace_ray, Family, TraceRoot};
 use raytrail_core::{Error, Hit, Ray};
 
 /// One chunk's rays, hit slots and (when recorded) enumeration slots.
@@ -18,6 +18,9 @@ pub(crate) struct Chunk<'a> {
 
 /// Traces one chunk; returns its counters (only `rays` is set when nothing is recorded).
 pub(crate) fn trace_chunk(scene: &PreparedBvh2, opts: &TraceOptions, chunk: Chunk<'_>) -> Result<Counters, Error> {
+    if opts.method.family() == Family::Kd {
+        return crate::dispatch_kd::trace_kd_chunk(scene, opts, chunk);
+    }
     let mem = scene.memory(opts.method)?;
     let root = scene.root(opts.method)?;
     let layout = scene.layout(opts.method)?;

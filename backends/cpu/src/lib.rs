@@ -11,6 +11,7 @@
 
 mod backend;
 mod dispatch;
+mod dispatch_kd;
 pub mod npy;
 pub mod ploc;
 

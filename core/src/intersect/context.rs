@@ -39,4 +39,12 @@ impl<T: TriangleTest> RayContext<T> {
         };
         Self { ray: *ray, slab: SlabRay::new(ray), tri: T::prepare(ray), t_slack }
     }
+
+    /// The interval boxes are tested over when the closest candidate so far is at `limit`:
+    /// `[tmin, limit]` widened by the slack on both ends, so a box is never culled while a
+    /// triangle inside it could still yield a computed `t` within `[tmin, limit]`.
+    #[inline(always)]
+    pub fn box_interval(&self, limit: f32) -> (f32, f32) {
+        (self.ray.tmin - self.t_slack, limit + self.t_slack)
+    }
 }

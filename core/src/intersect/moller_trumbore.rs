@@ -44,7 +44,8 @@ impl TriangleTest for MollerTrumbore {
             return None;
         }
         let t = e2.dot(q) * inv;
-        if t.is_nan() || t < tmin || t > tmax {
+        // A `t` that overflowed (directions near the float limits) is no hit.
+        if !t.is_finite() || t < tmin || t > tmax {
             return None;
         }
         Some(TriangleHit { t, u, v })

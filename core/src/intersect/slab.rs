@@ -1,9 +1,25 @@
 use crate::Ray;
 use glam::Vec3;
 
-/// The far-distance padding `1 + 2 * gamma(3)` of Ize (2013), as in pbrt, with
-/// `gamma(n) = n * eps / (1 - n * eps)` and `eps = 2^-24`, which makes the slab test conservative.
+/// The padding `1 + 2 * gamma(3)` of Ize (2013), as in pbrt, with `gamma(n) = n * eps / (1 - n *
+/// eps)` and `eps = 2^-24`, which makes the slab test conservative.
 pub const FAR_PAD: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+/// `1 - 2 * gamma(3)`: the same padding towards zero.
+const NEAR_PAD: f32 = 2.0 - FAR_PAD;
+
+/// Moves a distance up by the padding whatever its sign. Ize and pbrt pad only the far distance
+/// by `FAR_PAD`, which widens the interval only for `t > 0`; rays with a negative `tmin` test boxes
+/// behind their origin, where that product would shrink it (and a flat box would then be missed).
+#[inline(always)]
+fn widen_up(t: f32) -> f32 {
+    t * if t > 0.0 { FAR_PAD } else { NEAR_PAD }
+}
+
+/// Moves a distance down by the padding whatever its sign (see [`widen_up`]).
+#[inline(always)]
+fn widen_down(t: f32) -> f32 {
+    t * if t > 0.0 { NEAR_PAD } else { FAR_PAD }
+}
 
 /// The per-ray constants of the slab test.
 #[derive(Clone, Copy, Debug)]
@@ -37,7 +53,8 @@ impl SlabRay {
         }
     }
 
-    /// The robust slab test of box `[lo, hi]` over `[tmin, tmax]`.
+    /// The robust slab test of box `[lo, hi]` over `[tmin, tmax]`: both distances of every slab
+    /// are padded outwards (see [`widen_up`]).
     ///
     /// Near and far planes are picked by the direction's sign bit, so a `±0` component yields
     /// `±inf` distances rather than swapping planes. A `0 * inf` NaN (origin on a plane of a slab
@@ -48,9 +65,9 @@ impl SlabRay {
     pub fn hit(&self, lo: Vec3, hi: Vec3, tmin: f32, tmax: f32) -> Option<BoxHit> {
         let (near, far) = self.planes(lo, hi);
         let tn = (near - self.origin) * self.inv_dir;
-        let tf = (far - self.origin) * self.inv_dir * FAR_PAD;
-        let t_enter = keep_max(keep_max(keep_max(tmin, tn.x), tn.y), tn.z);
-        let t_exit = keep_min(keep_min(keep_min(tmax, tf.x), tf.y), tf.z);
+        let tf = (far - self.origin) * self.inv_dir;
+        let t_enter = keep_max(keep_max(keep_max(tmin, widen_down(tn.x)), widen_down(tn.y)), widen_down(tn.z));
+        let t_exit = keep_min(keep_min(keep_min(tmax, widen_up(tf.x)), widen_up(tf.y)), widen_up(tf.z));
         (t_enter <= t_exit).then_some(BoxHit { t_enter, t_exit })
     }
 
@@ -123,8 +140,17 @@ mod tests {
         assert!(r.hit(Vec3::ZERO, Vec3::ONE, 0.0, 0.5).is_none());
         assert!(r.hit(Vec3::ZERO, Vec3::ONE, 2.5, 9.0).is_none());
         let h = r.hit(Vec3::ZERO, Vec3::ONE, 0.0, 9.0).unwrap();
-        assert_eq!(h.t_enter, 1.0);
+        assert!(h.t_enter <= 1.0 && h.t_enter > 0.9999);
         assert!(h.t_exit >= 2.0 && h.t_exit < 2.0001);
+    }
+
+    #[test]
+    fn flat_box_behind_the_origin_is_hit() {
+        // A zero-thickness box at t = -1: padding must widen negative distances too.
+        let r = ray([0.5, 0.5, 1.0], [0.0, 0.0, 1.0]);
+        let h = r.hit(Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), f32::NEG_INFINITY, f32::INFINITY);
+        let h = h.expect("flat box behind the origin must be hit");
+        assert!(h.t_enter <= -1.0 && h.t_exit >= -1.0);
     }
 
     #[test]

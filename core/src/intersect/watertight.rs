@@ -79,7 +79,8 @@ impl TriangleTest for Watertight {
         let bz = sz * b[kz];
         let cz = sz * c[kz];
         let t = (u * az + v * bz + w * cz) / det;
-        if t.is_nan() || t < tmin || t > tmax {
+        // A `t` that overflowed (directions near the float limits) is no hit.
+        if !t.is_finite() || t < tmin || t > tmax {
             return None;
         }
         Some(TriangleHit { t, u: v / det, v: w / det })

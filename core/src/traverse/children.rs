@@ -19,11 +19,13 @@ pub enum Descent {
     },
 }
 
-/// Intersects the ray with both child boxes over `[tmin, limit]` and orders them: the child
-/// with the smaller entry distance first, ties to the left (the order every method shares).
+/// Intersects the ray with both child boxes over `[tmin, limit]` (widened by the ray's slack, see
+/// [`RayContext::box_interval`]) and orders them: the child with the smaller entry distance
+/// first, ties to the left (the order every method shares).
 #[inline(always)]
 pub fn order_children<T: TriangleTest>(node: &BinaryNode, ctx: &RayContext<T>, limit: f32) -> Descent {
-    order_with(&ctx.slab, node, ctx.ray.tmin, limit, ctx.t_slack)
+    let (lo, hi) = ctx.box_interval(limit);
+    order_with(&ctx.slab, node, lo, hi, ctx.t_slack)
 }
 
 #[inline(always)]

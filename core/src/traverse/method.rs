@@ -18,11 +18,46 @@ pub enum Method {
     HashDisjoint,
     /// (f) As (d), pausing after every hit and resuming from the node key (Sec. 2.4).
     HashResume,
+    /// kd-tree, standard stack traversal (Horn et al. 2007, A.1).
+    KdStack,
+    /// kd-tree, kd-restart (A.2).
+    KdRestart,
+    /// kd-tree, kd-restart with push-down (A.3).
+    KdPushDown,
+    /// kd-tree, short-stack with push-down, restarting on underflow (A.4).
+    KdShortStack,
+    /// kd-tree, packetized short-stack, packets of four rays of one direction octant (A.5).
+    KdPacket,
+}
+
+/// The acceleration structure a method traverses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Family {
+    /// The binary BVH.
+    Bvh2,
+    /// The kd-tree.
+    Kd,
 }
 
 impl Method {
     /// Every method.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 12] = [
+        Method::Stack,
+        Method::StackDisjoint,
+        Method::ParentSibling,
+        Method::Uncle,
+        Method::Hash,
+        Method::HashDisjoint,
+        Method::HashResume,
+        Method::KdStack,
+        Method::KdRestart,
+        Method::KdPushDown,
+        Method::KdShortStack,
+        Method::KdPacket,
+    ];
+
+    /// The BVH2 methods.
+    pub const BVH2: [Method; 7] = [
         Method::Stack,
         Method::StackDisjoint,
         Method::ParentSibling,
@@ -31,6 +66,19 @@ impl Method {
         Method::HashDisjoint,
         Method::HashResume,
     ];
+
+    /// The kd-tree methods.
+    pub const KD: [Method; 5] =
+        [Method::KdStack, Method::KdRestart, Method::KdPushDown, Method::KdShortStack, Method::KdPacket];
+
+    /// The structure the method traverses.
+    pub fn family(self) -> Family {
+        if Self::KD.contains(&self) {
+            Family::Kd
+        } else {
+            Family::Bvh2
+        }
+    }
 
     /// Command-line name.
     pub fn name(self) -> &'static str {
@@ -42,6 +90,11 @@ impl Method {
             Method::Hash => "hash",
             Method::HashDisjoint => "hash-disjoint",
             Method::HashResume => "hash-resume",
+            Method::KdStack => "kd-stack",
+            Method::KdRestart => "kd-restart",
+            Method::KdPushDown => "kd-push-down",
+            Method::KdShortStack => "kd-short-stack",
+            Method::KdPacket => "kd-packet",
         }
     }
 
@@ -50,10 +103,12 @@ impl Method {
         Self::ALL.into_iter().find(|m| m.name() == name)
     }
 
-    /// The method whose node enumeration this one must equal, closest hit and any hit alike.
+    /// The method whose node enumeration this one must equal, closest hit and any hit alike
+    /// (for kd methods the enumeration is the sequence of leaves: restarts revisit inner nodes).
     pub fn reference(self) -> Method {
         match self {
             Method::StackDisjoint | Method::HashDisjoint => Method::StackDisjoint,
+            m if m.family() == Family::Kd => Method::KdStack,
             _ => Method::Stack,
         }
     }
@@ -77,6 +132,16 @@ impl Method {
             Method::Hash | Method::HashResume => addr + 2 * key_bytes + 4,
             // ... and the disjoint-interval trail.
             Method::HashDisjoint => addr + 3 * key_bytes + 4,
+            // Node, segment [t_min, t_max], stack pointer, (node, t_min, t_max) per level.
+            Method::KdStack => addr + 8 + 4 + 12 * depth as usize,
+            // Node, segment, scene exit.
+            Method::KdRestart => addr + 12,
+            // ... and the restart node.
+            Method::KdPushDown => addr + 12 + 4,
+            // ... and three stack entries with their pointer (Horn et al.'s setting).
+            Method::KdShortStack => addr + 16 + 4 + 12 * 3,
+            // Per ray of the packet: as short-stack, plus a live bit per entry; shared node.
+            Method::KdPacket => 16 + 4 + 12 * 3 + 4,
         }
     }
 

@@ -28,7 +28,7 @@ mod stack;
 
 pub use children::{order_children, Descent};
 pub use leaf::intersect_leaf;
-pub use method::{Method, Query};
+pub use method::{Family, Method, Query};
 pub use parent_sibling::ParentSiblingState;
 pub use query::QueryState;
 pub use register::{Fallback, PerfectHashLookup, RegisterState, UncleHops};

@@ -57,6 +57,8 @@ pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
         Method::Hash => drive!(RegisterState::<K, PerfectHashLookup, false>::new(r)),
         Method::HashDisjoint => drive!(RegisterState::<K, PerfectHashLookup, true>::new(r)),
         Method::HashResume => trace_pausing::<K, M, T, O>(mem, root, &ctx, &mut q, obs),
+        // kd-tree methods run through `kd::traverse`; given BVH2 memory they find nothing.
+        _ => return Hit::MISS,
     }
     q.hit
 }

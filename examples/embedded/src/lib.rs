@@ -295,7 +295,7 @@ pub fn self_test() -> u32 {
         let ray = self_test_ray(i);
         let closest = scene.trace(&ray, Method::Stack, Query::Closest);
         let any = scene.trace(&ray, Method::Stack, Query::Any).is_hit();
-        let agrees = Method::ALL.iter().all(|&m| {
+        let agrees = Method::BVH2.iter().all(|&m| {
             scene.trace(&ray, m, Query::Closest).same_as(&closest) && scene.trace(&ray, m, Query::Any).is_hit() == any
         });
         agreeing += agrees as u32;
@@ -344,7 +344,7 @@ mod tests {
             let ray = self_test_ray(i);
             let want =
                 trace_ray::<u64, _, Watertight, _>(Method::Stack, &mem, root, &ray, Query::Closest, &mut NoObserver);
-            for m in Method::ALL {
+            for m in Method::BVH2 {
                 let got = trace(&ray, m);
                 assert!(got.same_as(&want), "ray {i}, {m}: flash {got:?}, host {want:?}");
             }

@@ -86,11 +86,11 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    /// Builds the SAH tree of `scene`, prepares it for [`Method::ALL`] and makes `kind` rays from a
+    /// Builds the SAH tree of `scene`, prepares it for [`Method::BVH2`] and makes `kind` rays from a
     /// `width` x `height` camera framing the scene (shadow and diffuse rays start at its hits).
     pub fn new(scene: Scene, kind: RayKind, width: u32, height: u32) -> Result<Scenario, String> {
         let bvh = SahBuilder::default().build(scene.triangles()).map_err(|e| e.to_string())?;
-        let prepared = PreparedBvh2::new(&scene, bvh, &Method::ALL).map_err(|e| e.to_string())?;
+        let prepared = PreparedBvh2::new(&scene, bvh, &Method::BVH2).map_err(|e| e.to_string())?;
         let camera = primary(&scene, width, height);
         let rays = match kind {
             RayKind::Primary => camera,

@@ -40,7 +40,7 @@ fn parse(args: &[String]) -> Result<Option<Args>, String> {
         height: 192,
         warp: 32,
         rays: RayKind::Primary,
-        methods: Method::ALL.to_vec(),
+        methods: Method::BVH2.to_vec(),
         timeline: None,
     };
     let mut it = args.iter();

@@ -66,6 +66,8 @@ impl Transition {
                     Backtrack::Register(_) => 'r',
                     Backtrack::Hash { .. } => 'h',
                     Backtrack::Iterative => 'w',
+                    // Restarts belong to the kd methods, which the simulator does not step.
+                    Backtrack::Restart => 'x',
                 };
                 if leaf {
                     c.to_ascii_uppercase()
@@ -227,6 +229,12 @@ fn simulate_keyed<K: Key>(
         Method::Hash => sim.run::<RegisterState<K, PerfectHashLookup, false>>(rays),
         Method::HashDisjoint => sim.run::<RegisterState<K, PerfectHashLookup, true>>(rays),
         Method::HashResume => sim.run::<Resuming<K>>(rays),
+        kd => {
+            return Err(Error::NotPrepared {
+                method: kd.name(),
+                missing: "a BVH2 method (the simulator steps BVH2 traversals)",
+            })
+        }
     };
     run.report.method = method;
     run.report.traffic = mem.traffic();
@@ -406,6 +414,8 @@ impl<M: BvhMemory> Sim<'_, M> {
                             Backtrack::Register(_) => r.transitions.register += 1,
                             Backtrack::Hash { .. } => r.transitions.hash += 1,
                             Backtrack::Iterative => r.transitions.iterative += 1,
+                            // Only kd methods restart, and they are not simulated.
+                            Backtrack::Restart => r.transitions.iterative += 1,
                         }
                         Transition::Backtrack { leaf: is_leaf, via: b }
                     }

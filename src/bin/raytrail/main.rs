@@ -21,7 +21,8 @@ USAGE:
   raytrail rays --scene FILE --out RAYS.npy [--width W] [--height H]
       writes primary rays (Morton order) framing the scene, for `trace`
 
-METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume
+METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
+         kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree)
 SCENES:  OBJ, PLY (ASCII or binary), optionally gzip-compressed; `builtin` is a generated sphereflake";
 
 fn main() {

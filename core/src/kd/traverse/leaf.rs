@@ -1,0 +1,39 @@
+use crate::bvh2::NodeRef;
+use crate::intersect::{RayContext, TriangleTest};
+use crate::kd::{KdMemory, KdNode};
+use crate::observe::Observer;
+use crate::traverse::QueryState;
+
+/// Tests the ray against every triangle of kd leaf `index` (a triangle may sit in several
+/// leaves; it is tested in each, and the answer does not depend on where it is found first).
+///
+/// Returns whether traversal may stop after this leaf: an any-hit query was answered, or the
+/// closest hit so far lies before the leaf's exit `t_max` by more than the ray's `t_slack`, so no
+/// later leaf can hold anything closer or tied (Horn et al.'s early exit `tHit < tMax`, made
+/// conservative against rounding in the triangle test).
+#[inline(always)]
+pub fn kd_leaf<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
+    mem: &M,
+    index: u32,
+    node: &KdNode,
+    t_max: f32,
+    ctx: &RayContext<T>,
+    q: &mut QueryState,
+    obs: &mut O,
+) -> bool {
+    obs.node(NodeRef::leaf(index));
+    for i in node.first()..node.first() + node.count() {
+        let prim = mem.prim_ref(i);
+        obs.primitive(prim);
+        let [a, b, c] = mem.triangle(prim);
+        if let Some(h) = T::intersect(&ctx.tri, a, b, c, ctx.ray.tmin, q.limit()) {
+            if q.offer(h, prim) {
+                obs.hit(prim, h.t);
+                if q.any {
+                    return true;
+                }
+            }
+        }
+    }
+    q.hit.is_hit() && q.hit.t + ctx.t_slack < t_max
+}
