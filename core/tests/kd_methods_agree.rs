@@ -11,27 +11,8 @@ use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::traverse::{Method, Query};
 use raytrail_core::{Hit, Ray};
 
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        ((self.0 >> 40) as f32) / (1u64 << 24) as f32
-    }
-    fn v(&mut self) -> Vec3 {
-        Vec3::new(self.f(), self.f(), self.f())
-    }
-}
-
-fn soup(n: usize, seed: u64) -> Vec<Triangle> {
-    let mut r = Rng(seed);
-    (0..n)
-        .map(|_| {
-            let c = r.v() * 10.0;
-            let s = 0.05 + r.f() * 1.5;
-            Triangle::new(c, c + (r.v() - 0.5) * s, c + (r.v() - 0.5) * s)
-        })
-        .collect()
-}
+mod common;
+use common::{soup, Rng};
 
 /// Axis-aligned quads on a grid: triangles lie in split planes and share edges.
 fn boxes(n: usize) -> Vec<Triangle> {
@@ -169,7 +150,7 @@ fn check(tris: Vec<Triangle>, seed: u64) {
 
 #[test]
 fn kd_methods_agree_on_a_soup() {
-    check(soup(3000, 3), 5);
+    check(soup(3000, 3, 1.5), 5);
 }
 
 #[test]

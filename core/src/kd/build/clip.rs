@@ -5,10 +5,10 @@ use crate::geometry::Triangle;
 use crate::Aabb;
 use glam::Vec3;
 
-/// A triangle clipped by six planes has at most nine vertices (ten with a seventh plane); rounding
-/// can make the polygon slightly non-convex, so there is room for more, and a polygon that would
-/// still overflow falls back to the conservative answer.
-const MAX_VERTICES: usize = 12;
+/// A triangle clipped by the six planes of a box has at most nine vertices; rounding can make the
+/// polygon slightly non-convex, so there is room for one more, and a polygon that would still
+/// overflow falls back to the conservative answer.
+const MAX_VERTICES: usize = 10;
 
 type Vertices = [[f64; 3]; MAX_VERTICES];
 
@@ -60,14 +60,7 @@ pub(super) fn split_clipped_bounds(
     }
     let side = |upper: bool, plane: f32, child: &Aabb| {
         let plane = if upper { plane as f64 + poly.tol } else { plane as f64 - poly.tol };
-        // Into a spare buffer, leaving the polygon for the other side.
-        let mut out = [[0.0; 3]; MAX_VERTICES];
-        match clip(poly.vertices(), &mut out, axis, plane, upper) {
-            Ok(None) => Some(bounds(poly.vertices(), child)),
-            Ok(Some(0)) => None,
-            Ok(Some(n)) => Some(bounds(&out[..n], child)),
-            Err(Overflow) => Some(intersect(*tri_bounds, child)),
-        }
+        clipped_polygon_bounds(poly.vertices(), axis, plane, upper, child)
     };
     (side(true, below_max, &below), side(false, above_min, &above))
 }
@@ -204,6 +197,40 @@ fn clip(
     Ok(Some(n))
 }
 
+/// [`bounds`] of what [`clip`] would give, without storing the polygon; `None` if nothing is
+/// inside.
+fn clipped_polygon_bounds(poly: &[[f64; 3]], axis: usize, plane: f64, upper: bool, cell: &Aabb) -> Option<Aabb> {
+    let inside = |p: &[f64; 3]| if upper { p[axis] <= plane } else { p[axis] >= plane };
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut grow = |p: &[f64; 3]| {
+        for k in 0..3 {
+            // Plain comparisons: no NaN can occur, and `min`/`max` would handle it.
+            lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
+            hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
+        }
+    };
+    let mut prev = &poly[poly.len() - 1];
+    let mut prev_in = inside(prev);
+    for cur in poly {
+        let cur_in = inside(cur);
+        if cur_in != prev_in {
+            let t = (plane - prev[axis]) / (cur[axis] - prev[axis]);
+            let mut p = [0.0; 3];
+            for k in 0..3 {
+                p[k] = prev[k] + t * (cur[k] - prev[k]);
+            }
+            p[axis] = plane;
+            grow(&p);
+        }
+        if cur_in {
+            grow(cur);
+        }
+        (prev, prev_in) = (cur, cur_in);
+    }
+    (lo[0] <= hi[0]).then(|| rounded_bounds(lo, hi, cell))
+}
+
 /// Bounds of `poly` rounded outward to `f32` and cut to `cell` (the planes were moved outward, so
 /// points may lie just outside it).
 fn bounds(poly: &[[f64; 3]], cell: &Aabb) -> Aabb {
@@ -211,13 +238,23 @@ fn bounds(poly: &[[f64; 3]], cell: &Aabb) -> Aabb {
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in poly {
         for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
+            lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
+            hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
         }
     }
-    let lo = Vec3::new(round_down(lo[0]), round_down(lo[1]), round_down(lo[2]));
-    let hi = Vec3::new(round_up(hi[0]), round_up(hi[1]), round_up(hi[2]));
-    Aabb { min: lo.clamp(cell.min, cell.max), max: hi.clamp(cell.min, cell.max) }
+    rounded_bounds(lo, hi, cell)
+}
+
+/// `[lo, hi]` rounded outward to `f32` and cut to `cell`.
+fn rounded_bounds(lo: [f64; 3], hi: [f64; 3], cell: &Aabb) -> Aabb {
+    let (min, max) = (cell.min.to_array(), cell.max.to_array());
+    // Coordinates at or beyond a face (the clipped ones) are that face; only the others round.
+    let down = |x: f64, k: usize| if x <= min[k] as f64 { min[k] } else { round_down(x).min(max[k]) };
+    let up = |x: f64, k: usize| if x >= max[k] as f64 { max[k] } else { round_up(x).max(min[k]) };
+    Aabb {
+        min: Vec3::new(down(lo[0], 0), down(lo[1], 1), down(lo[2], 2)),
+        max: Vec3::new(up(hi[0], 0), up(hi[1], 1), up(hi[2], 2)),
+    }
 }
 
 /// The largest `f32` not above `x`.

@@ -13,8 +13,9 @@
 //! `s - m`. So:
 //! - a triangle touching a plane, by a vertex, an edge or lying in it, goes to both children (the
 //!   closed half-boxes), and so does one passing within `m` of it: each leaf holds every triangle
-//!   that meets its cell grown by `m`, and rounding in a ray's plane crossings or in the triangle
-//!   test (a few ulps of the coordinates) can never make a traversal miss a triangle near a plane;
+//!   that meets its cell grown by `m`, so that rounding in a ray's plane crossings or in the
+//!   triangle test (a few ulps of the distances, for rays starting in or near the scene) cannot
+//!   make a traversal miss a triangle near a plane;
 //! - candidate planes lie `2m` outside a triangle's clipped bounds, never on them, so that empty
 //!   space is cut off cleanly (a wall lies on one side of a plane just beside it, the side the
 //!   SAH prefers) instead of the wall landing on both sides of a plane through it.
@@ -50,10 +51,11 @@ pub struct KdConfig {
     /// & Havran's 20% bonus for cutting off empty space; 1 disables it.
     pub empty_bonus: f32,
     /// Depth cap; nodes at the cap become leaves holding whatever reaches them. 0 (the default)
-    /// means automatic: `8 + 1.3 log2(N)` for `N` triangles. Never above [`Self::MAX_DEPTH`].
+    /// means automatic: `8 + 1.3 log2(N)` for `N` triangles, rounded down. Never above
+    /// [`Self::MAX_DEPTH`].
     pub max_depth: u32,
-    /// Bins per axis of the binned search in nodes of more than 64 references (default 32; at
-    /// least 2, at most 1024). Smaller nodes are swept exactly.
+    /// Bins per axis of the binned search in nodes of more than 32 references (default 32; at
+    /// least 2, at most 1024). Smaller nodes are searched exactly.
     pub bins: usize,
 }
 
@@ -67,21 +69,32 @@ impl KdConfig {
     /// Deepest depth cap: keys of depth-63 nodes fit 64 bits (root key 1).
     pub const MAX_DEPTH: u32 = 63;
 
-    /// The depth cap for `triangle_count` triangles: `max_depth`, or `round(8 + 1.3 log2(N))`
-    /// when it is 0, at most [`Self::MAX_DEPTH`]. Integer arithmetic (no float `log2` in `no_std`):
-    /// `log2` is the bit length plus the linear interpolation of the remaining bits.
+    /// The depth cap for `triangle_count` triangles: `max_depth`, or `8 + 1.3 log2(N)` rounded
+    /// down when it is 0, at most [`Self::MAX_DEPTH`]. Integer arithmetic (`no_std` has no float
+    /// `log2`): `log2(N)` to 10 fractional bits.
     pub fn depth_cap(&self, triangle_count: usize) -> u32 {
         if self.max_depth > 0 {
             return self.max_depth.min(Self::MAX_DEPTH);
         }
-        let n = triangle_count.max(1) as u64;
-        let k = 63 - n.leading_zeros() as u64;
-        // log2(n) in 1/1024 units: k plus the fraction (n - 2^k) / 2^k.
-        let fraction = (((n - (1 << k)) as u128) << 10 >> k) as u64;
-        let log2 = k * 1024 + fraction;
-        let depth = 8 + (13 * log2 + 5 * 1024) / (10 * 1024);
+        let depth = 8 + 13 * log2_fixed10(triangle_count.max(1) as u64) / (10 << 10);
         (depth as u32).min(Self::MAX_DEPTH)
     }
+}
+
+/// `log2(n)` in units of `2^-10`, rounded down (for `n >= 1`): the bit length gives the integer
+/// part; squaring the mantissa (in [1, 2), 32 fractional bits) yields one fractional bit a step.
+fn log2_fixed10(n: u64) -> u64 {
+    let k = 63 - n.leading_zeros() as u64;
+    let mut m = ((n as u128) << 32 >> k) as u64;
+    let mut log2 = k << 10;
+    for bit in (0..10).rev() {
+        m = ((m as u128 * m as u128) >> 32) as u64;
+        if m >= 2 << 32 {
+            m >>= 1;
+            log2 |= 1 << bit;
+        }
+    }
+    log2
 }
 
 /// The SAH kd-tree builder (see the module documentation for the rules).
@@ -170,7 +183,7 @@ impl KdBuilder {
             debug_assert_eq!(refs.len(), w.end, "a popped node's references are on top");
             refs.truncate(w.end);
             let split = if w.depth < depth_cap { finder.find(&refs[w.start..], &w.cell, w.same_refs) } else { None };
-            let Some(Split { axis, pos }) = split else {
+            let Some(Split { axis, pos, exact_counts }) = split else {
                 let first = prims.len();
                 prims.extend(refs[w.start..].iter().map(|r| r.prim));
                 prims[first..].sort_unstable();
@@ -192,57 +205,28 @@ impl KdBuilder {
             let (mut below_cell, mut above_cell) = (w.cell, w.cell);
             below_cell.max[axis] = pos;
             above_cell.min[axis] = pos;
-            // Clipping is against the child cells grown by the margin: the side rule's region.
-            let grow = |c: Aabb| Aabb { min: c.min - margin, max: c.max + margin };
-            let (below_clip, above_clip, parent_clip) = (grow(below_cell), grow(above_cell), grow(w.cell));
-            // One pass: the references going below are gathered aside, those going above are
-            // compacted in place (each reference yields at most one, never ahead of the reader).
-            below_refs.clear();
-            let mut kept = w.start;
-            for i in w.start..w.end {
-                let r = refs[i];
-                let (lo, hi) = (r.bounds.min[axis], r.bounds.max[axis]);
-                let t = &triangles[r.prim as usize];
-                let tb = &tri_bounds[r.prim as usize];
-                let clip_below = lo <= pos + margin && hi > pos + margin;
-                let clip_above = hi >= pos - margin && lo < pos - margin;
-                let (mut to_below, mut to_above) = match (clip_below, clip_above) {
-                    // Crossing the whole margin band: clip once to the parent, then per side.
-                    (true, true) => {
-                        let (b, a) = clip::split_clipped_bounds(t, tb, &parent_clip, axis, pos + margin, pos - margin);
-                        (b.map(|c| shrink(r.bounds, c)), a.map(|c| shrink(r.bounds, c)))
-                    }
-                    (true, false) => (
-                        clip::clipped_bounds(t, tb, &below_clip).map(|c| shrink(r.bounds, c)),
-                        (hi >= pos - margin).then_some(r.bounds),
-                    ),
-                    (false, true) => (
-                        (lo <= pos + margin).then_some(r.bounds),
-                        clip::clipped_bounds(t, tb, &above_clip).map(|c| shrink(r.bounds, c)),
-                    ),
-                    (false, false) => {
-                        ((lo <= pos + margin).then_some(r.bounds), (hi >= pos - margin).then_some(r.bounds))
-                    }
-                };
-                if to_below.is_none() && to_above.is_none() {
-                    // The triangle meets the parent's region, so it meets one child's; rounding
-                    // said otherwise: keep it on both sides.
-                    to_below = Some(shrink(r.bounds, below_clip));
-                    to_above = Some(shrink(r.bounds, above_clip));
-                }
-                if let Some(bounds) = to_below {
-                    below_refs.push(Ref { bounds, prim: r.prim });
-                }
-                if let Some(bounds) = to_above {
-                    refs[kept] = Ref { bounds, prim: r.prim };
-                    kept += 1;
-                }
-            }
-            refs.truncate(kept);
-            refs.extend_from_slice(&below_refs);
+            let kept = match exact_counts {
+                // Empty space cut off: every reference goes to the other side unclipped (one
+                // reaching the plane's margin band would go to both), so they stay where they
+                // are; the empty child gets an empty range at the right end.
+                Some((0, _)) => w.end,
+                Some((_, 0)) => w.start,
+                _ => partition(
+                    &mut refs,
+                    &mut below_refs,
+                    w.start..w.end,
+                    Plane { axis, pos, margin },
+                    (triangles, &tri_bounds),
+                    (&w.cell, &below_cell, &above_cell),
+                ),
+            };
             let depth = w.depth + 1;
             let (above_count, below_count) = (kept - w.start, refs.len() - kept);
             let count = w.end - w.start;
+            if let Some((b, a)) = exact_counts {
+                // Clipping may only drop a reference from a side the count included.
+                debug_assert!(below_count <= b as usize && above_count <= a as usize);
+            }
             // The child below is built first: its references are on top.
             todo.push(Work {
                 node: below + 1,
@@ -265,6 +249,75 @@ impl KdBuilder {
     }
 }
 
+/// A split plane and the side rule's margin.
+#[derive(Clone, Copy)]
+struct Plane {
+    axis: usize,
+    pos: f32,
+    margin: f32,
+}
+
+/// Distributes the references `refs[range]` of a node split at `plane`: those going above are
+/// compacted in place from `range.start`, those going below follow them (gathered in `below_refs`
+/// on the way; a reference yields at most one of each, never ahead of the reader). A reference
+/// crossing the plane's margin band is clipped to each child's cell grown by the margin. Returns
+/// where the references going below start; `refs` then ends with them.
+fn partition(
+    refs: &mut Vec<Ref>,
+    below_refs: &mut Vec<Ref>,
+    range: core::ops::Range<usize>,
+    plane: Plane,
+    (triangles, tri_bounds): (&[Triangle], &[Aabb]),
+    (cell, below_cell, above_cell): (&Aabb, &Aabb, &Aabb),
+) -> usize {
+    let Plane { axis, pos, margin } = plane;
+    // Clipping is against the cells grown by the margin: the side rule's regions.
+    let grow = |c: &Aabb| Aabb { min: c.min - margin, max: c.max + margin };
+    let (below_clip, above_clip, parent_clip) = (grow(below_cell), grow(above_cell), grow(cell));
+    below_refs.clear();
+    let mut kept = range.start;
+    for i in range {
+        let r = refs[i];
+        let (lo, hi) = (r.bounds.min[axis], r.bounds.max[axis]);
+        let t = &triangles[r.prim as usize];
+        let tb = &tri_bounds[r.prim as usize];
+        let clip_below = lo <= pos + margin && hi > pos + margin;
+        let clip_above = hi >= pos - margin && lo < pos - margin;
+        let (mut to_below, mut to_above) = match (clip_below, clip_above) {
+            // Crossing the whole margin band: clip once to the parent, then per side.
+            (true, true) => {
+                let (b, a) = clip::split_clipped_bounds(t, tb, &parent_clip, axis, pos + margin, pos - margin);
+                (b.map(|c| shrink(r.bounds, c)), a.map(|c| shrink(r.bounds, c)))
+            }
+            (true, false) => (
+                clip::clipped_bounds(t, tb, &below_clip).map(|c| shrink(r.bounds, c)),
+                (hi >= pos - margin).then_some(r.bounds),
+            ),
+            (false, true) => (
+                (lo <= pos + margin).then_some(r.bounds),
+                clip::clipped_bounds(t, tb, &above_clip).map(|c| shrink(r.bounds, c)),
+            ),
+            (false, false) => ((lo <= pos + margin).then_some(r.bounds), (hi >= pos - margin).then_some(r.bounds)),
+        };
+        if to_below.is_none() && to_above.is_none() {
+            // The triangle meets the parent's region, so it meets one child's; rounding said
+            // otherwise: keep it on both sides.
+            to_below = Some(shrink(r.bounds, below_clip));
+            to_above = Some(shrink(r.bounds, above_clip));
+        }
+        if let Some(bounds) = to_below {
+            below_refs.push(Ref { bounds, prim: r.prim });
+        }
+        if let Some(bounds) = to_above {
+            refs[kept] = Ref { bounds, prim: r.prim };
+            kept += 1;
+        }
+    }
+    refs.truncate(kept);
+    refs.extend_from_slice(below_refs);
+    kept
+}
+
 /// `a` cut to `b` (both hold the true clipped triangle, so their overlap does too); `b` alone where
 /// rounding leaves no overlap.
 fn shrink(a: Aabb, b: Aabb) -> Aabb {
@@ -283,11 +336,23 @@ mod tests {
     use glam::Vec3;
 
     #[test]
+    fn log2_to_ten_fractional_bits() {
+        assert_eq!(log2_fixed10(1), 0);
+        assert_eq!(log2_fixed10(2), 1024);
+        assert_eq!(log2_fixed10(1 << 40), 40 << 10);
+        assert_eq!(log2_fixed10(3), 1623); // 1.58496 * 1024 = 1623.0
+        assert_eq!(log2_fixed10(1000), 10204); // 9.96578 * 1024 = 10204.9
+        assert_eq!(log2_fixed10(u64::MAX), (64 << 10) - 1);
+    }
+
+    #[test]
     fn automatic_depth_follows_8_plus_1_3_log2_n() {
         let cfg = KdConfig::default();
         assert_eq!(cfg.depth_cap(1), 8);
         assert_eq!(cfg.depth_cap(1024), 21); // 8 + 13
-        assert_eq!(cfg.depth_cap(871_414), 34); // log2 = 19.73: 33.6
+        assert_eq!(cfg.depth_cap(6_320), 24); // 24.41
+        assert_eq!(cfg.depth_cap(69_666), 28); // 28.91
+        assert_eq!(cfg.depth_cap(871_414), 33); // log2 = 19.733: 33.65
         assert_eq!(cfg.depth_cap(usize::MAX), KdConfig::MAX_DEPTH);
         assert_eq!(KdConfig { max_depth: 100, ..cfg }.depth_cap(10), KdConfig::MAX_DEPTH);
         assert_eq!(KdConfig { max_depth: 5, ..cfg }.depth_cap(10), 5);

@@ -28,6 +28,9 @@ const EXACT_MAX: usize = 32;
 pub(super) struct Split {
     pub axis: usize,
     pub pos: f32,
+    /// References going below and above, when counted exactly (not binned): the builder's side
+    /// rule gives these very counts.
+    pub exact_counts: Option<(u32, u32)>,
 }
 
 /// The SAH search with its reusable buffers (no allocation per node).
@@ -56,16 +59,19 @@ struct Candidate {
     above: u32,
 }
 
-/// One axis of the cell, in `f64` so that areas neither overflow nor underflow.
+/// One axis of the cell and the constants of the split cost on it (in `f64`, so that areas
+/// neither overflow nor underflow).
 struct AxisGeometry {
     axis: usize,
     lo: f32,
     hi: f32,
-    /// Area of the cell's cross-section perpendicular to the axis.
-    cross: f64,
-    /// Sum of the two other extents: the area grows by this per unit along the axis.
-    perimeter: f64,
-    inv_area: f64,
+    /// Cost of a split at `p` with `nb` references below and `na` above:
+    /// `C_t + per_ref (nb + na) + per_ref_and_length ((p - lo) nb + (hi - p) na)`, from the child
+    /// areas `cross + (p - lo) perimeter` and `cross + (hi - p) perimeter` relative to the cell's,
+    /// where `cross` is the cell's section across the axis and `perimeter` the sum of the two
+    /// other extents.
+    per_ref: f64,
+    per_ref_and_length: f64,
 }
 
 /// Best candidate so far.
@@ -104,7 +110,7 @@ impl SplitFinder {
         let e = [0, 1, 2].map(|a| cell.max[a] as f64 - cell.min[a] as f64);
         let area = e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
         // A cell flat in two axes (a segment or a point) holds only degenerate triangles.
-        if n == 0 || !(area > 0.0) {
+        if n == 0 || area <= 0.0 {
             return None;
         }
         let mut best = Best { cost: self.intersection * n as f64, split: None };
@@ -113,20 +119,20 @@ impl SplitFinder {
             // No plane fits strictly inside a flat axis.
             if e[a] > 0.0 {
                 let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+                let relative = self.intersection / area;
                 *slot = Some(AxisGeometry {
                     axis: a,
                     lo: cell.min[a],
                     hi: cell.max[a],
-                    cross: e[b] * e[c],
-                    perimeter: e[b] + e[c],
-                    inv_area: 1.0 / area,
+                    per_ref: e[b] * e[c] * relative,
+                    per_ref_and_length: (e[b] + e[c]) * relative,
                 });
             }
         }
         if same_refs && self.cache_refs == n {
             for c in &self.cache {
                 if let Some(g) = &axes[c.axis as usize] {
-                    self.consider(&mut best, g, c.pos, c.below, c.above);
+                    self.consider(&mut best, g, c.pos, c.below, c.above, true);
                 }
             }
             return best.split;
@@ -143,24 +149,23 @@ impl SplitFinder {
         best.split
     }
 
-    /// Takes the plane `pos` on `g`'s axis with `below` and `above` references if it beats
-    /// `best`. Planes outside the open cell are ignored.
+    /// Takes the plane `pos` on `g`'s axis with `below` and `above` references (`exact`: counted
+    /// exactly) if it beats `best`. Planes outside the open cell are ignored.
     #[inline]
-    fn consider(&self, best: &mut Best, g: &AxisGeometry, pos: f32, below: u32, above: u32) {
+    fn consider(&self, best: &mut Best, g: &AxisGeometry, pos: f32, below: u32, above: u32, exact: bool) {
         if !(pos > g.lo && pos < g.hi) {
             return;
         }
-        let p = pos as f64;
-        let area_below = g.cross + (p - g.lo as f64) * g.perimeter;
-        let area_above = g.cross + (g.hi as f64 - p) * g.perimeter;
-        let mut cost =
-            self.traversal + self.intersection * (area_below * below as f64 + area_above * above as f64) * g.inv_area;
-        if below == 0 || above == 0 {
-            cost *= self.empty_factor;
-        }
+        let (p, nb, na) = (pos as f64, below as f64, above as f64);
+        let length_below = p - g.lo as f64;
+        let length_above = g.hi as f64 - p;
+        let cost =
+            self.traversal + g.per_ref * (nb + na) + g.per_ref_and_length * (length_below * nb + length_above * na);
+        let cost = if below == 0 || above == 0 { cost * self.empty_factor } else { cost };
         if cost < best.cost {
             // `+ 0.0` turns `-0.0` into `+0.0`: one plane, one representation.
-            *best = Best { cost, split: Some(Split { axis: g.axis, pos: pos + 0.0 }) };
+            let exact_counts = exact.then_some((below, above));
+            *best = Best { cost, split: Some(Split { axis: g.axis, pos: pos + 0.0, exact_counts }) };
         }
     }
 
@@ -188,15 +193,16 @@ impl SplitFinder {
                 }
                 let (below, above) = count_sides(counted_starts, counted_ends, pos + m, pos - m);
                 self.cache.push(Candidate { pos, axis: a as u32, below, above });
-                self.consider(best, g, pos, below, above);
+                self.consider(best, g, pos, below, above, true);
             }
         }
     }
 
     /// Binned search on all axes at once (one pass over the references). The bins hold the bounds
     /// grown by the margin, under which the side rule is the closed one: below when the grown
-    /// start is at most the plane, above when the grown end is at least it. Counts are exact up to
-    /// values sharing a bin with the candidate; the partition is exact either way.
+    /// start is at most the plane, above when the grown end is at least it. Counts are estimates,
+    /// off only by references whose grown bounds share the candidate's bin; the partition is
+    /// exact either way.
     fn binned(&mut self, refs: &[Ref], axes: &[Option<AxisGeometry>; 3], best: &mut Best) {
         let bins = self.bins;
         let n = refs.len();
@@ -210,8 +216,10 @@ impl SplitFinder {
             axes.each_ref().map(|g| g.as_ref().map_or(0.0, |g| (bins as f64 / (g.hi as f64 - g.lo as f64)) as f32));
         let lo = axes.each_ref().map(|g| g.as_ref().map_or(0.0, |g| g.lo));
         let top = (bins - 1) as f32;
-        // Clamped in float first so the conversion needs no saturation handling.
-        let bin = |v: f32, a: usize| ((v - lo[a]) * scale[a]).max(0.0).min(top) as usize;
+        let bin = |v: f32, a: usize| {
+            let x = (v - lo[a]) * scale[a];
+            (if x < top { x } else { top }) as usize
+        };
         let (count_lo, count_hi) = (&mut self.count_lo[..3 * bins], &mut self.count_hi[..3 * bins]);
         let (lowest, highest) = (&mut self.lowest[..3 * bins], &mut self.highest[..3 * bins]);
         for r in refs {
@@ -236,18 +244,25 @@ impl SplitFinder {
                 let (lo_count, hi_count) = (self.count_lo[base + i] as usize, self.count_hi[base + i] as usize);
                 if i > 0 {
                     let pos = (g.lo as f64 + width * i as f64) as f32;
-                    self.consider(best, g, pos, starts_before as u32, (n - ends_before) as u32);
+                    self.consider(best, g, pos, starts_before as u32, (n - ends_before) as u32, false);
                 }
                 if lo_count > 0 {
-                    // A margin below the lowest grown start in this bin (`2m` below the bound):
-                    // exact above, an upper bound below.
+                    // A margin below the lowest grown start in this bin (`2m` below the bound),
+                    // so that reference goes above: empty space is cut off tightly.
                     let pos = self.lowest[base + i] - m;
-                    self.consider(best, g, pos, starts_before as u32, (n - ends_before) as u32);
+                    self.consider(best, g, pos, starts_before as u32, (n - ends_before) as u32, false);
                 }
                 if hi_count > 0 {
                     // A margin above the highest grown end in this bin.
                     let pos = self.highest[base + i] + m;
-                    self.consider(best, g, pos, (starts_before + lo_count) as u32, (n - ends_before - hi_count) as u32);
+                    self.consider(
+                        best,
+                        g,
+                        pos,
+                        (starts_before + lo_count) as u32,
+                        (n - ends_before - hi_count) as u32,
+                        false,
+                    );
                 }
                 starts_before += lo_count;
                 ends_before += hi_count;

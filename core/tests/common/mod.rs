@@ -1,0 +1,32 @@
+//! What the core's integration tests share: a tiny deterministic generator and a triangle soup.
+
+use glam::Vec3;
+use raytrail_core::geometry::Triangle;
+
+/// A linear congruential generator: deterministic, no dependency.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// Uniform in `[0, 1)`.
+    pub fn f(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 40) as f32) / (1u64 << 24) as f32
+    }
+
+    /// Uniform in the unit cube.
+    pub fn v(&mut self) -> Vec3 {
+        Vec3::new(self.f(), self.f(), self.f())
+    }
+}
+
+/// `n` random triangles in a 10-unit cube, edges up to `size` long.
+pub fn soup(n: usize, seed: u64, size: f32) -> Vec<Triangle> {
+    let mut r = Rng(seed);
+    (0..n)
+        .map(|_| {
+            let c = r.v() * 10.0;
+            let s = 0.05 + r.f() * size;
+            Triangle::new(c, c + (r.v() - 0.5) * s, c + (r.v() - 0.5) * s)
+        })
+        .collect()
+}
