@@ -31,13 +31,22 @@ impl<T: TriangleTest> RayContext<T> {
         let reach = scene_scale + ray.origin().abs().max_element();
         let d = ray.dir().abs().max_element();
         // The watertight test forms products of order reach^3 / |d|; where they come near the
-        // float range its `t` is unreliable, and an infinite slack turns pruning off.
+        // float range its `t` is unreliable: the slack is then infinite (see `is_reliable`).
         let t_slack = if reach * reach * (reach / d) < f32::MAX / 256.0 {
             SLACK_ULPS * f32::EPSILON * reach / d
         } else {
             f32::INFINITY
         };
-        Self { ray: *ray, slab: SlabRay::new(ray), tri: T::prepare(ray), t_slack }
+        let slab = SlabRay { slack: t_slack, ..SlabRay::new(ray) };
+        Self { ray: *ray, slab, tri: T::prepare(ray), t_slack }
+    }
+
+    /// Whether the ray's distances across the scene stay clear of the float range. Where they do
+    /// not (directions around 1e-30 and below for a unit-size scene), the triangle test's products
+    /// overflow and no method can answer reliably: every method treats such a ray as a miss.
+    #[inline(always)]
+    pub fn is_reliable(&self) -> bool {
+        self.t_slack.is_finite()
     }
 
     /// The interval boxes are tested over when the closest candidate so far is at `limit`:

@@ -38,6 +38,9 @@ pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
         return Hit::MISS;
     }
     let ctx = RayContext::<T>::new(ray, root.scene_scale);
+    if !ctx.is_reliable() {
+        return Hit::MISS;
+    }
     let mut q = QueryState::new(ray, query == Query::Any);
     let r = root.node;
     macro_rules! drive {

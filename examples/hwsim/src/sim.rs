@@ -353,16 +353,20 @@ impl<M: BvhMemory> Sim<'_, M> {
         let mut lanes: Vec<Lane<S>> = rays
             .iter()
             .enumerate()
-            .map(|(i, ray)| Lane {
-                ray: first + i,
-                state: S::start(self.root.node),
-                ctx: RayContext::new(ray, self.root.scene_scale),
-                q: QueryState::new(ray, any),
-                obs: LaneObserver { nodes: self.cfg.record_enumerations.then(Vec::new), ..LaneObserver::default() },
-                steps: 0,
-                live_stack: 0,
-                // As `trace_ray`: a ray that cannot hit anything visits nothing.
-                done: !ray.is_traceable(),
+            .map(|(i, ray)| {
+                let ctx = RayContext::new(ray, self.root.scene_scale);
+                Lane {
+                    ray: first + i,
+                    state: S::start(self.root.node),
+                    q: QueryState::new(ray, any),
+                    obs: LaneObserver { nodes: self.cfg.record_enumerations.then(Vec::new), ..LaneObserver::default() },
+                    steps: 0,
+                    live_stack: 0,
+                    // As `trace_ray`: a ray that cannot hit anything, or whose distances overflow,
+                    // visits nothing.
+                    done: !ray.is_traceable() || !ctx.is_reliable(),
+                    ctx,
+                }
             })
             .collect();
         let r = &mut out.report;

@@ -47,7 +47,7 @@ pub fn trace_kd_packet<const W: usize, M: KdMemory + ?Sized, T: TriangleTest, O:
     for i in 0..n {
         if rays[i].is_traceable() {
             let c = RayContext::<T>::new(&rays[i], root.scene_scale);
-            if let Some((a, b)) = scene_interval(&c, root) {
+            if let Some((a, b)) = scene_interval(&c, root).filter(|_| c.is_reliable()) {
                 (t_min[i], t_max[i], scene_max[i], done[i]) = (a, b, b, false);
                 ctx[i] = Some(c);
             }

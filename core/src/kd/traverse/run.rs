@@ -47,6 +47,9 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
         return Hit::MISS;
     }
     let ctx = RayContext::<T>::new(ray, root.scene_scale);
+    if !ctx.is_reliable() {
+        return Hit::MISS;
+    }
     let Some((t0, t1)) = scene_interval(&ctx, root) else {
         return Hit::MISS;
     };
