@@ -8,13 +8,15 @@
 #![cfg(feature = "std")]
 
 // In a module so that `cargo test kd` selects these tests.
+mod common;
+
 mod kd {
+    use crate::common::scene_file;
     use glam::Vec3;
     use raytrail_core::geometry::Triangle;
     use raytrail_core::intersect::{TriangleTest, Watertight};
     use raytrail_core::kd::{KdBuilder, KdConfig, KdTree};
     use raytrail_core::{Aabb, Hit, Ray};
-    use std::path::PathBuf;
 
     struct Rng(u64);
 
@@ -523,21 +525,6 @@ mod kd {
 
     // ---------------------------------------------------------------------------------------------
     // Real meshes
-
-    fn scene_file(file: &str) -> Option<PathBuf> {
-        let dir = std::env::var_os("RAYTRAIL_SCENES")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes")));
-        let path = dir.join(file);
-        if path.is_file() {
-            return Some(path);
-        }
-        if std::env::var("RAYTRAIL_ALLOW_MISSING_SCENES").as_deref() == Ok("1") {
-            println!("skipped: {} not found (RAYTRAIL_ALLOW_MISSING_SCENES=1)", path.display());
-            return None;
-        }
-        panic!("test scene {} not found (set RAYTRAIL_SCENES or RAYTRAIL_ALLOW_MISSING_SCENES=1)", path.display());
-    }
 
     fn load(file: &str) -> Option<Vec<Triangle>> {
         let path = scene_file(file)?;

@@ -4,34 +4,18 @@
 //! overrides it. A missing folder fails the tests unless `RAYTRAIL_ALLOW_MISSING_SCENES=1`.
 #![cfg(feature = "std")]
 
+mod common;
+
 mod mesh {
+    use crate::common::scene_file;
     use raytrail_core::mesh::{self, load, load_bytes};
     use raytrail_core::scene::Mesh;
     use std::io::Write;
     use std::path::{Path, PathBuf};
     use std::time::Instant;
 
-    fn scene(file: &str) -> Option<PathBuf> {
-        let dir = std::env::var_os("RAYTRAIL_SCENES")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes")));
-        let path = dir.join(file);
-        if path.is_file() {
-            return Some(path);
-        }
-        if std::env::var("RAYTRAIL_ALLOW_MISSING_SCENES").as_deref() == Ok("1") {
-            println!("skipped: {} not found (RAYTRAIL_ALLOW_MISSING_SCENES=1)", path.display());
-            return None;
-        }
-        panic!(
-            "test scene {} not found: point RAYTRAIL_SCENES at the scenes folder \
-             (see shared/scenes/SOURCES.md), or set RAYTRAIL_ALLOW_MISSING_SCENES=1 to skip",
-            path.display()
-        );
-    }
-
     fn check_scene(file: &str, triangles: usize) {
-        let Some(path) = scene(file) else { return };
+        let Some(path) = scene_file(file) else { return };
         let start = Instant::now();
         let mesh = load(&path).unwrap_or_else(|e| panic!("{e}"));
         let took = start.elapsed();
@@ -105,7 +89,7 @@ mod mesh {
     #[test]
     fn obj_fans_in_file_order() {
         for file in ["cornell_box.obj", "sponza.obj", "kitchen.obj"] {
-            let Some(path) = scene(file) else { return };
+            let Some(path) = scene_file(file) else { return };
             let mesh = load(&path).unwrap();
             let got: Vec<[[f32; 3]; 3]> =
                 mesh.triangles.iter().map(|t| t.map(|i| mesh.positions[i as usize].to_array())).collect();

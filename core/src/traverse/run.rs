@@ -20,6 +20,17 @@ pub struct TraceRoot {
     pub max_steps: u32,
 }
 
+/// The per-ray constants and an empty answer, or `None` for a ray every method treats as a miss
+/// (not traceable, or with distances that overflow: [`RayContext::is_reliable`]).
+#[inline(always)]
+pub fn begin<T: TriangleTest>(ray: &Ray, scene_scale: f32, query: Query) -> Option<(RayContext<T>, QueryState)> {
+    if !ray.is_traceable() {
+        return None;
+    }
+    let ctx = RayContext::<T>::new(ray, scene_scale);
+    ctx.is_reliable().then(|| (ctx, QueryState::new(ray, query == Query::Any)))
+}
+
 /// Traces one ray with `method` over `mem` (which must hold what the method needs: the
 /// parent/sibling layout for [`Method::ParentSibling`], the uncle layout otherwise, and the hash
 /// tables for the hash methods). `K` is the key and trail type the tree's depth needs.
@@ -34,14 +45,9 @@ pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
     query: Query,
     obs: &mut O,
 ) -> Hit {
-    if !ray.is_traceable() {
+    let Some((ctx, mut q)) = begin::<T>(ray, root.scene_scale, query) else {
         return Hit::MISS;
-    }
-    let ctx = RayContext::<T>::new(ray, root.scene_scale);
-    if !ctx.is_reliable() {
-        return Hit::MISS;
-    }
-    let mut q = QueryState::new(ray, query == Query::Any);
+    };
     let r = root.node;
     macro_rules! drive {
         ($state:expr) => {{

@@ -1,4 +1,7 @@
 //! What the core's integration tests share: a tiny deterministic generator and a triangle soup.
+//!
+//! Each test file uses a part of it; the rest would be dead code there.
+#![allow(dead_code)]
 
 use glam::Vec3;
 use raytrail_core::geometry::Triangle;
@@ -29,4 +32,25 @@ pub fn soup(n: usize, seed: u64, size: f32) -> Vec<Triangle> {
             Triangle::new(c, c + (r.v() - 0.5) * s, c + (r.v() - 0.5) * s)
         })
         .collect()
+}
+
+/// A mesh of `shared/scenes` (or `RAYTRAIL_SCENES`); `None`, with a printed reason, only when
+/// `RAYTRAIL_ALLOW_MISSING_SCENES=1` and the file is missing; otherwise a missing file fails.
+pub fn scene_file(file: &str) -> Option<std::path::PathBuf> {
+    let dir = std::env::var_os("RAYTRAIL_SCENES")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes")));
+    let path = dir.join(file);
+    if path.is_file() {
+        return Some(path);
+    }
+    if std::env::var("RAYTRAIL_ALLOW_MISSING_SCENES").as_deref() == Ok("1") {
+        println!("skipped: {} not found (RAYTRAIL_ALLOW_MISSING_SCENES=1)", path.display());
+        return None;
+    }
+    panic!(
+        "test scene {} not found: point RAYTRAIL_SCENES at the scenes folder \
+         (see shared/scenes/SOURCES.md), or set RAYTRAIL_ALLOW_MISSING_SCENES=1 to skip",
+        path.display()
+    );
 }

@@ -179,12 +179,7 @@ fn clip(
         let cur_in = inside(cur);
         if cur_in != prev_in {
             // The edge crosses the plane: add the crossing, exactly on the plane along `axis`.
-            let t = (plane - prev[axis]) / (cur[axis] - prev[axis]);
-            let mut p = [0.0; 3];
-            for k in 0..3 {
-                p[k] = prev[k] + t * (cur[k] - prev[k]);
-            }
-            p[axis] = plane;
+            let p = crossing(prev, cur, axis, plane);
             *out.get_mut(n).ok_or(Overflow)? = p;
             n += 1;
         }
@@ -195,6 +190,18 @@ fn clip(
         (prev, prev_in) = (cur, cur_in);
     }
     Ok(Some(n))
+}
+
+/// Where the edge `prev`-`cur` crosses the plane, placed exactly on it along `axis`.
+#[inline]
+fn crossing(prev: &[f64; 3], cur: &[f64; 3], axis: usize, plane: f64) -> [f64; 3] {
+    let t = (plane - prev[axis]) / (cur[axis] - prev[axis]);
+    let mut p = [0.0; 3];
+    for k in 0..3 {
+        p[k] = prev[k] + t * (cur[k] - prev[k]);
+    }
+    p[axis] = plane;
+    p
 }
 
 /// [`bounds`] of what [`clip`] would give, without storing the polygon; `None` if nothing is
@@ -215,12 +222,7 @@ fn clipped_polygon_bounds(poly: &[[f64; 3]], axis: usize, plane: f64, upper: boo
     for cur in poly {
         let cur_in = inside(cur);
         if cur_in != prev_in {
-            let t = (plane - prev[axis]) / (cur[axis] - prev[axis]);
-            let mut p = [0.0; 3];
-            for k in 0..3 {
-                p[k] = prev[k] + t * (cur[k] - prev[k]);
-            }
-            p[axis] = plane;
+            let p = crossing(prev, cur, axis, plane);
             grow(&p);
         }
         if cur_in {

@@ -3,7 +3,7 @@ use crate::bvh2::NodeRef;
 use crate::intersect::{RayContext, TriangleTest};
 use crate::kd::KdMemory;
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::QueryState;
+use crate::traverse::{begin, Query, QueryState};
 use crate::{Hit, Ray};
 
 /// Rays per packet: four, as on the paper's GPU and in one SSE register.
@@ -45,11 +45,11 @@ pub fn trace_kd_packet<const W: usize, M: KdMemory + ?Sized, T: TriangleTest, O:
     let (mut t_min, mut t_max, mut scene_max) = ([0.0f32; W], [0.0f32; W], [0.0f32; W]);
     let mut done = [true; W];
     for i in 0..n {
-        if rays[i].is_traceable() {
-            let c = RayContext::<T>::new(&rays[i], root.scene_scale);
-            if let Some((a, b)) = scene_interval(&c, root).filter(|_| c.is_reliable()) {
+        let query = if any { Query::Any } else { Query::Closest };
+        if let Some((c, qi)) = begin::<T>(&rays[i], root.scene_scale, query) {
+            if let Some((a, b)) = scene_interval(&c, root) {
                 (t_min[i], t_max[i], scene_max[i], done[i]) = (a, b, b, false);
-                ctx[i] = Some(c);
+                (ctx[i], q[i]) = (Some(c), qi);
             }
         }
     }

@@ -2,7 +2,7 @@ use super::{KdRestartState, KdStackState};
 use crate::intersect::{RayContext, TriangleTest};
 use crate::kd::KdMemory;
 use crate::observe::Observer;
-use crate::traverse::{Method, Query, QueryState, Step};
+use crate::traverse::{begin, Method, Query, Step};
 use crate::{Hit, Ray};
 use glam::Vec3;
 
@@ -43,17 +43,12 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
     query: Query,
     obs: &mut O,
 ) -> Hit {
-    if !ray.is_traceable() {
+    let Some((ctx, mut q)) = begin::<T>(ray, root.scene_scale, query) else {
         return Hit::MISS;
-    }
-    let ctx = RayContext::<T>::new(ray, root.scene_scale);
-    if !ctx.is_reliable() {
-        return Hit::MISS;
-    }
+    };
     let Some((t0, t1)) = scene_interval(&ctx, root) else {
         return Hit::MISS;
     };
-    let mut q = QueryState::new(ray, query == Query::Any);
     macro_rules! drive {
         ($state:expr) => {{
             let mut s = $state;
