@@ -3,12 +3,14 @@
 //! This package gathers the crates and ships the `raytrail` command line:
 //! - [`core`]: the `no_std` core (types, tests, keys, layouts, perfect hashing, state machines);
 //! - [`cpu`]: the rayon backend, the obvhs (PLOC) builder and NumPy files;
+//! - [`gpu`]: the wgpu backend (WGSL kernels mirroring the core's state machines);
 //! - [`conformance`]: the scenes, ray sets and cross-method checks.
 #![warn(missing_docs)]
 
 pub use raytrail_conformance as conformance;
 pub use raytrail_core as core;
 pub use raytrail_cpu as cpu;
+pub use raytrail_wgpu as gpu;
 
 use raytrail_conformance::NamedScene;
 use raytrail_core::bvh2::{Bvh2, SahBuilder};

@@ -206,6 +206,52 @@ pub fn compare(ctx: Context<'_>, rays: &[Ray], outcomes: &[Outcome]) -> Vec<Mism
     out
 }
 
+/// Compares a backend's outcomes with the CPU's for the same methods and query, ray by ray:
+/// hits bit for bit (any hit: occluded or not) and enumerations exactly. The mismatches name the
+/// backend as `ctx.backend` and the method as its own reference.
+pub fn compare_backends(ctx: Context<'_>, rays: &[Ray], cpu: &[Outcome], other: &[Outcome]) -> Vec<Mismatch> {
+    let mut out = Vec::new();
+    for o in other {
+        let Some(c) = cpu.iter().find(|c| c.method == o.method && c.query == o.query) else {
+            continue;
+        };
+        let mut push = |i: usize, difference: Difference| {
+            out.push(Mismatch {
+                scene: ctx.scene.to_string(),
+                ray_set: ctx.ray_set.to_string(),
+                backend: format!("{} vs cpu", ctx.backend),
+                method: o.method,
+                reference: o.method,
+                query: o.query,
+                ray_index: i,
+                ray: rays[i],
+                difference,
+            })
+        };
+        for (i, (e, g)) in c.hits.iter().zip(&o.hits).enumerate() {
+            let differs = match o.query {
+                Query::Closest => !e.same_as(g),
+                Query::Any => e.is_hit() != g.is_hit(),
+            };
+            if differs {
+                push(
+                    i,
+                    match o.query {
+                        Query::Closest => Difference::Hit { expected: *e, got: *g },
+                        Query::Any => Difference::Occlusion { expected: e.is_hit(), got: g.is_hit() },
+                    },
+                );
+            }
+        }
+        for (i, (e, g)) in c.enumerations.iter().zip(&o.enumerations).enumerate() {
+            if e != g {
+                push(i, Difference::Enumeration { expected: e.clone(), got: g.clone() });
+            }
+        }
+    }
+    out
+}
+
 /// Runs every method for both queries on one ray set and compares; the mismatches found.
 pub fn check_ray_set<B: Trace>(
     backend: &B,

@@ -56,6 +56,14 @@ pub enum Error {
         /// What is missing.
         missing: &'static str,
     },
+    /// A backend's device failed or lacks something (no adapter, a missing feature, a limit).
+    #[cfg(feature = "alloc")]
+    Device {
+        /// The backend.
+        backend: &'static str,
+        /// What went wrong, in the backend's words.
+        detail: alloc::string::String,
+    },
 }
 
 impl fmt::Display for Error {
@@ -80,6 +88,8 @@ impl fmt::Display for Error {
             Error::NotPrepared { method, missing } => {
                 write!(f, "method {method} needs {missing}, which the scene was not prepared with")
             }
+            #[cfg(feature = "alloc")]
+            Error::Device { backend, detail } => write!(f, "{backend} backend: {detail}"),
         }
     }
 }

@@ -6,7 +6,7 @@ use raytrail_core::key::{Key, KeyWidth};
 use raytrail_core::observe::{Both, Counters, NoObserver, Recorder};
 use raytrail_core::prepared::PreparedBvh2;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
-use raytrail_core::traverse::{trace_ray, Family, TraceRoot};
+use raytrail_core::traverse::{trace_batch, trace_ray, Family, TraceRoot};
 use raytrail_core::{Error, Hit, Ray};
 
 /// One chunk's rays, hit slots and (when recorded) enumeration slots.
@@ -46,14 +46,10 @@ impl Run<'_> {
         let mut counters = Counters::default();
         match self.opts.record {
             Record::Nothing => {
-                for (ray, hit) in chunk.rays.iter().zip(chunk.hits.iter_mut()) {
-                    *hit = trace_ray::<K, _, T, _>(method, &self.mem, self.root, ray, query, &mut NoObserver);
-                }
+                trace_batch::<K, _, T, _>(method, &self.mem, self.root, chunk.rays, chunk.hits, query, &mut NoObserver);
             }
             Record::Counters => {
-                for (ray, hit) in chunk.rays.iter().zip(chunk.hits.iter_mut()) {
-                    *hit = trace_ray::<K, _, T, _>(method, &self.mem, self.root, ray, query, &mut counters);
-                }
+                trace_batch::<K, _, T, _>(method, &self.mem, self.root, chunk.rays, chunk.hits, query, &mut counters);
             }
             Record::Enumerations => {
                 let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());

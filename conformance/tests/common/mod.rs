@@ -1,5 +1,7 @@
 //! What every conformance test file shares: the suite's scenes, ray sets, and how a mismatch is
 //! reported (loudly, with the scene, the ray, both enumerations and where they part).
+// Each test binary uses its own part of this module.
+#![allow(dead_code, unused_macros)]
 
 use raytrail_conformance::check::{check_ray_set, Context, Mismatch};
 use raytrail_conformance::paths::{load_mesh_scene, scenes_dir};
@@ -9,9 +11,17 @@ use raytrail_core::bvh2::Bvh2;
 use raytrail_core::prepared::PreparedBvh2;
 use raytrail_core::trace::{Trace, TraceOptions};
 use raytrail_core::traverse::Method;
+use raytrail_core::traverse::Query;
 use raytrail_core::Hit;
 use raytrail_cpu::CpuBackend;
 use std::sync::Arc;
+
+pub mod gpu;
+#[macro_use]
+mod suite;
+
+/// Both queries, in the order the suite checks them.
+pub const ALL_QUERIES: [Query; 2] = [Query::Closest, Query::Any];
 
 /// Set to 1 to let the mesh tests pass without `../shared/scenes` (they then print why).
 pub const ALLOW_MISSING: &str = "RAYTRAIL_ALLOW_MISSING_SCENES";
@@ -52,17 +62,20 @@ pub fn check_scene(named: &NamedScene, bvh: Bvh2, size: RaySetSize) {
     }
     assert!(checked > 0, "{}: no rays were checked", named.name);
     if !mismatches.is_empty() {
-        let mut msg = format!(
-            "\n{} MISMATCHES in scene {} ({} rays x {} methods x 2 queries checked). First ones:\n",
-            mismatches.len(),
-            named.name,
-            checked,
-            Method::ALL.len()
-        );
-        for m in mismatches.iter().take(6) {
-            msg.push_str(&m.to_string());
-        }
-        panic!("{msg}");
+        panic!("{}", mismatch_report(&named.name, "cpu", checked, &mismatches));
     }
     eprintln!("{}: {} rays x {} methods x 2 queries conform", named.name, checked, Method::ALL.len());
+}
+
+/// The loud failure message: how many mismatches, where, and the first ones in full.
+pub fn mismatch_report(scene: &str, backend: &str, checked: usize, mismatches: &[Mismatch]) -> String {
+    let mut msg = format!(
+        "\n{} MISMATCHES in scene {scene} on {backend} ({checked} rays x {} methods x 2 queries checked). First ones:\n",
+        mismatches.len(),
+        Method::ALL.len()
+    );
+    for m in mismatches.iter().take(6) {
+        msg.push_str(&m.to_string());
+    }
+    msg
 }

@@ -8,7 +8,7 @@
 
 mod memory;
 mod node;
-pub use memory::{BvhMemory, SliceMemory};
+pub use memory::{BvhMemory, MemRead, SliceMemory};
 pub use node::{BinaryNode, LeafWord, NodeRef};
 
 #[cfg(feature = "alloc")]

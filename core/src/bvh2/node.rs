@@ -117,6 +117,13 @@ impl LeafWord {
         Vec3::new(f32::from_bits(self.0[0]), f32::from_bits(self.0[1]), f32::from_bits(self.0[2]))
     }
 
+    /// The vertex stored in a triangle entry, read in place.
+    #[inline(always)]
+    pub fn vertex_ref(&self) -> &[f32; 3] {
+        let slots: &[f32; 4] = bytemuck::cast_ref(&self.0);
+        slots.first_chunk().expect("an entry has four slots")
+    }
+
     /// The primitive id of a triangle's first entry (or the link in entries 1 and 2).
     #[inline(always)]
     pub fn prim(&self) -> u32 {

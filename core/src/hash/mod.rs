@@ -49,7 +49,10 @@ pub fn lookup<K: Key, M: BvhMemory + ?Sized>(mem: &M, shape: HashShape, key: K) 
         let r = if a < 0xC000_0000 { a - 0x8000_0000 } else { a };
         (NodeRef(r), true)
     } else {
-        let slot = (key.to_u64() + d as u64) % shape.h as u64;
+        // Reduced first: a depth-63 key plus a displacement can exceed 2^64 (the builder places
+        // keys the same way, and the GPU's 64-bit emulation computes this very expression).
+        let h = shape.h as u64;
+        let slot = (key.to_u64() % h + d as u64) % h;
         (NodeRef(mem.hash_cell(slot as u32)), false)
     }
 }

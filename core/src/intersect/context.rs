@@ -1,4 +1,4 @@
-use super::{SlabRay, TriangleTest};
+use super::{SlabPair, SlabRay, TriangleTest};
 use crate::Ray;
 
 /// Everything a traversal knows about its ray: the ray and both tests' per-ray constants.
@@ -8,6 +8,8 @@ pub struct RayContext<T: TriangleTest> {
     pub ray: Ray,
     /// Slab-test constants.
     pub slab: SlabRay,
+    /// The same constants arranged for testing both child boxes of a node at once.
+    pub pair: SlabPair,
     /// Triangle-test constants.
     pub tri: T::PerRay,
     /// A bound on how far a triangle hit's computed `t` may stray from the computed interval of
@@ -16,8 +18,13 @@ pub struct RayContext<T: TriangleTest> {
 }
 
 /// Units of `f32::EPSILON` in [`RayContext::t_slack`]: generous against the few roundings of
-/// the watertight test's `t`, small against any real gap between boxes.
-const SLACK_ULPS: f32 = 64.0;
+/// the watertight test's `t`, small against any real gap between boxes. Shaders receive
+/// `SLACK_ULPS * f32::EPSILON` bit for bit.
+pub const SLACK_ULPS: f32 = 64.0;
+
+/// Bound on `reach^3 / |d|` below which a ray's distances are reliable (see
+/// [`RayContext::is_reliable`]); shaders receive it bit for bit.
+pub const RELIABLE_LIMIT: f32 = f32::MAX / 256.0;
 
 impl<T: TriangleTest> RayContext<T> {
     /// Computes the per-ray constants; call only for a traceable ray ([`Ray::is_traceable`]).
@@ -32,13 +39,13 @@ impl<T: TriangleTest> RayContext<T> {
         let d = ray.dir().abs().max_element();
         // The watertight test forms products of order reach^3 / |d|; where they come near the
         // float range its `t` is unreliable: the slack is then infinite (see `is_reliable`).
-        let t_slack = if reach * reach * (reach / d) < f32::MAX / 256.0 {
+        let t_slack = if reach * reach * (reach / d) < RELIABLE_LIMIT {
             SLACK_ULPS * f32::EPSILON * reach / d
         } else {
             f32::INFINITY
         };
         let slab = SlabRay { slack: t_slack, ..SlabRay::new(ray) };
-        Self { ray: *ray, slab, tri: T::prepare(ray), t_slack }
+        Self { ray: *ray, slab, pair: SlabPair::new(&slab), tri: T::prepare(ray), t_slack }
     }
 
     /// Whether the ray's distances across the scene stay clear of the float range. Where they do

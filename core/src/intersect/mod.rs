@@ -6,11 +6,13 @@
 mod context;
 mod moller_trumbore;
 mod slab;
+mod slab_pair;
 mod watertight;
 
-pub use context::RayContext;
+pub use context::{RayContext, RELIABLE_LIMIT, SLACK_ULPS};
 pub use moller_trumbore::MollerTrumbore;
 pub use slab::{BoxHit, SlabRay, FAR_PAD};
+pub use slab_pair::{hit_pair_scalar, SlabPair};
 pub use watertight::Watertight;
 
 use crate::Ray;
@@ -37,4 +39,11 @@ pub trait TriangleTest: Copy + Default + Send + Sync + 'static {
     fn prepare(ray: &Ray) -> Self::PerRay;
     /// Hit of the ray with triangle `(a, b, c)` for `t` in `[tmin, tmax]`, if any.
     fn intersect(ray: &Self::PerRay, a: Vec3, b: Vec3, c: Vec3, tmin: f32, tmax: f32) -> Option<TriangleHit>;
+    /// [`TriangleTest::intersect`] with the vertices read where they are stored, so a test that
+    /// picks coordinates by a per-ray index loads just those; the default copies the vertices.
+    #[inline(always)]
+    fn intersect_in_place(ray: &Self::PerRay, v: [&[f32; 3]; 3], tmin: f32, tmax: f32) -> Option<TriangleHit> {
+        let [a, b, c] = v.map(|p| Vec3::from_array(*p));
+        Self::intersect(ray, a, b, c, tmin, tmax)
+    }
 }

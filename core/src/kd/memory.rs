@@ -1,4 +1,5 @@
 use super::KdNode;
+use crate::bvh2::MemRead;
 use crate::geometry::Triangle;
 use glam::Vec3;
 
@@ -11,6 +12,12 @@ pub trait KdMemory {
     fn prim_ref(&self, i: u32) -> u32;
     /// The vertices of primitive `prim`.
     fn triangle(&self, prim: u32) -> [Vec3; 3];
+    /// The vertices of primitive `prim` for reading: [`KdMemory::triangle`]'s copy unless the
+    /// memory can lend them in place (as [`KdSliceMemory`] does).
+    #[inline(always)]
+    fn read_triangle(&self, prim: u32) -> MemRead<'_, [Vec3; 3]> {
+        MemRead::Copied(self.triangle(prim))
+    }
 }
 
 /// A kd-tree and the scene's triangles in plain slices: the CPU backend's memory.
@@ -36,5 +43,9 @@ impl KdMemory for KdSliceMemory<'_> {
     #[inline(always)]
     fn triangle(&self, prim: u32) -> [Vec3; 3] {
         self.triangles[prim as usize].v
+    }
+    #[inline(always)]
+    fn read_triangle(&self, prim: u32) -> MemRead<'_, [Vec3; 3]> {
+        MemRead::InPlace(&self.triangles[prim as usize].v)
     }
 }

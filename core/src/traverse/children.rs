@@ -1,5 +1,5 @@
 use crate::bvh2::BinaryNode;
-use crate::intersect::{RayContext, SlabRay, TriangleTest};
+use crate::intersect::{BoxHit, RayContext, TriangleTest};
 
 /// Where traversal goes from an internal node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,14 +25,13 @@ pub enum Descent {
 #[inline(always)]
 pub fn order_children<T: TriangleTest>(node: &BinaryNode, ctx: &RayContext<T>, limit: f32) -> Descent {
     let (lo, hi) = ctx.box_interval(limit);
-    order_with(&ctx.slab, node, lo, hi, ctx.t_slack)
+    order(ctx.pair.hit_pair(node, lo, hi), ctx.t_slack)
 }
 
+/// The descent for the two child boxes' hits.
 #[inline(always)]
-fn order_with(slab: &SlabRay, node: &BinaryNode, tmin: f32, limit: f32, slack: f32) -> Descent {
-    let (l0, l1) = node.child_bounds(0);
-    let (r0, r1) = node.child_bounds(1);
-    match (slab.hit(l0, l1, tmin, limit), slab.hit(r0, r1, tmin, limit)) {
+fn order([left, right]: [Option<BoxHit>; 2], slack: f32) -> Descent {
+    match (left, right) {
         (None, None) => Descent::Neither,
         (Some(_), None) => Descent::One(0),
         (None, Some(_)) => Descent::One(1),

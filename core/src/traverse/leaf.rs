@@ -18,14 +18,15 @@ pub fn intersect_leaf<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
     let mut o = offset;
     let mut accepted = false;
     loop {
-        let w0 = mem.leaf_word(o);
+        let w0 = mem.read_leaf_word(o);
         if w0.is_terminator() {
             return (w0.links(), accepted);
         }
         let prim = w0.prim();
         obs.primitive(prim);
-        let (w1, w2) = (mem.leaf_word(o + 1), mem.leaf_word(o + 2));
-        if let Some(h) = T::intersect(&ctx.tri, w0.vertex(), w1.vertex(), w2.vertex(), ctx.ray.tmin, q.limit()) {
+        let (w1, w2) = (mem.read_leaf_word(o + 1), mem.read_leaf_word(o + 2));
+        let vertices = [w0.vertex_ref(), w1.vertex_ref(), w2.vertex_ref()];
+        if let Some(h) = T::intersect_in_place(&ctx.tri, vertices, ctx.ray.tmin, q.limit()) {
             if q.offer(h, prim) {
                 obs.hit(prim, h.t);
                 accepted = true;

@@ -36,7 +36,7 @@ impl<K: Key> ParentSiblingState<K> {
         }
         obs.node(self.addr);
         let links = if !self.addr.is_leaf() {
-            let node = mem.node(self.addr.index());
+            let node = mem.read_node(self.addr.index());
             match order_children(&node, ctx, q.limit()) {
                 Descent::One(i) => {
                     self.trail = self.trail.shl(1);
@@ -73,7 +73,7 @@ impl<K: Key> ParentSiblingState<K> {
                 return Step::Done;
             }
             obs.link_read(parent);
-            links = mem.node(parent.index()).links;
+            links = mem.read_node(parent.index()).links;
             self.trail = self.trail.shr(1);
             levels += 1;
         }

@@ -142,7 +142,7 @@ impl<K: Key, F: Fallback, const DISJOINT: bool> RegisterState<K, F, DISJOINT> {
         }
         obs.node(self.addr);
         if !self.addr.is_leaf() {
-            let node = mem.node(self.addr.index());
+            let node = mem.read_node(self.addr.index());
             if self.mrpn.is_none() {
                 self.refill::<O>([node.links[0], node.links[1], NodeRef::NONE]);
             }

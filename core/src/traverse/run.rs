@@ -1,6 +1,6 @@
 use super::{
-    trace_pausing, Method, ParentSiblingState, PerfectHashLookup, Query, QueryState, RegisterState, StackState, Step,
-    UncleHops,
+    trace_pausing, Fallback, Method, ParentSiblingState, PerfectHashLookup, Query, QueryState, RegisterState,
+    StackState, Step, UncleHops,
 };
 use crate::bvh2::{BvhMemory, NodeRef};
 use crate::intersect::{RayContext, TriangleTest};
@@ -45,29 +45,153 @@ pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
     query: Query,
     obs: &mut O,
 ) -> Hit {
-    let Some((ctx, mut q)) = begin::<T>(ray, root.scene_scale, query) else {
-        return Hit::MISS;
-    };
+    let mut hit = Hit::MISS;
+    trace_batch::<K, M, T, O>(
+        method,
+        mem,
+        root,
+        core::slice::from_ref(ray),
+        core::slice::from_mut(&mut hit),
+        query,
+        obs,
+    );
+    hit
+}
+
+/// Traces `rays` into `hits` (pairs up to the shorter of the two), each exactly as [`trace_ray`]
+/// would, with the method dispatched once per batch and a stack set up once per batch rather than
+/// once per ray (the CPU backend's hot loop).
+#[inline]
+pub fn trace_batch<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
+    method: Method,
+    mem: &M,
+    root: TraceRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    obs: &mut O,
+) {
     let r = root.node;
-    macro_rules! drive {
-        ($state:expr) => {{
-            let mut s = $state;
-            let mut budget = root.max_steps;
-            while s.step(mem, &ctx, &mut q, obs) != Step::Done && budget > 0 {
-                budget -= 1;
-            }
-        }};
-    }
     match method {
-        Method::Stack => drive!(StackState::<false>::new(r)),
-        Method::StackDisjoint => drive!(StackState::<true>::new(r)),
-        Method::ParentSibling => drive!(ParentSiblingState::<K>::new(r)),
-        Method::Uncle => drive!(RegisterState::<K, UncleHops, false>::new(r)),
-        Method::Hash => drive!(RegisterState::<K, PerfectHashLookup, false>::new(r)),
-        Method::HashDisjoint => drive!(RegisterState::<K, PerfectHashLookup, true>::new(r)),
-        Method::HashResume => trace_pausing::<K, M, T, O>(mem, root, &ctx, &mut q, obs),
+        Method::Stack => {
+            let mut s = StackState::<false>::new(r);
+            for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+                s.restart(r);
+                drive(&mut s, mem, ctx, q, obs, root.max_steps);
+            });
+        }
+        Method::StackDisjoint => {
+            let mut s = StackState::<true>::new(r);
+            for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+                s.restart(r);
+                drive(&mut s, mem, ctx, q, obs, root.max_steps);
+            });
+        }
+        Method::ParentSibling => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+            drive(&mut ParentSiblingState::<K>::new(r), mem, ctx, q, obs, root.max_steps)
+        }),
+        Method::Uncle => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+            drive(&mut RegisterState::<K, UncleHops, false>::new(r), mem, ctx, q, obs, root.max_steps)
+        }),
+        Method::Hash => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+            drive(&mut RegisterState::<K, PerfectHashLookup, false>::new(r), mem, ctx, q, obs, root.max_steps)
+        }),
+        Method::HashDisjoint => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+            drive(&mut RegisterState::<K, PerfectHashLookup, true>::new(r), mem, ctx, q, obs, root.max_steps)
+        }),
+        Method::HashResume => {
+            for_each_ray::<T>(rays, hits, root, query, |ctx, q| trace_pausing::<K, M, T, O>(mem, root, ctx, q, obs))
+        }
         // kd-tree methods run through `kd::traverse`; given BVH2 memory they find nothing.
-        _ => return Hit::MISS,
+        _ => hits.iter_mut().for_each(|h| *h = Hit::MISS),
     }
-    q.hit
+}
+
+/// Sets up each ray ([`begin`]), lets `trace` answer it and stores the answer; a ray that
+/// [`begin`] turns away is a miss.
+#[inline(always)]
+fn for_each_ray<T: TriangleTest>(
+    rays: &[Ray],
+    hits: &mut [Hit],
+    root: TraceRoot,
+    query: Query,
+    mut trace: impl FnMut(&RayContext<T>, &mut QueryState),
+) {
+    for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+        *hit = match begin::<T>(ray, root.scene_scale, query) {
+            Some((ctx, mut q)) => {
+                trace(&ctx, &mut q);
+                q.hit
+            }
+            None => Hit::MISS,
+        };
+    }
+}
+
+/// A BVH2 traversal state that makes one transition per [`Machine::step`].
+trait Machine {
+    /// One transition; see [`Step`].
+    fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
+        &mut self,
+        mem: &M,
+        ctx: &RayContext<T>,
+        q: &mut QueryState,
+        obs: &mut O,
+    ) -> Step;
+}
+
+impl<const DISJOINT: bool> Machine for StackState<DISJOINT> {
+    #[inline(always)]
+    fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
+        &mut self,
+        mem: &M,
+        ctx: &RayContext<T>,
+        q: &mut QueryState,
+        obs: &mut O,
+    ) -> Step {
+        StackState::step(self, mem, ctx, q, obs)
+    }
+}
+
+impl<K: Key> Machine for ParentSiblingState<K> {
+    #[inline(always)]
+    fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
+        &mut self,
+        mem: &M,
+        ctx: &RayContext<T>,
+        q: &mut QueryState,
+        obs: &mut O,
+    ) -> Step {
+        ParentSiblingState::step(self, mem, ctx, q, obs)
+    }
+}
+
+impl<K: Key, F: Fallback, const DISJOINT: bool> Machine for RegisterState<K, F, DISJOINT> {
+    #[inline(always)]
+    fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
+        &mut self,
+        mem: &M,
+        ctx: &RayContext<T>,
+        q: &mut QueryState,
+        obs: &mut O,
+    ) -> Step {
+        RegisterState::step(self, mem, ctx, q, obs)
+    }
+}
+
+/// Steps `state` until it is done, or for at most `max_steps` further steps after the first
+/// (see [`TraceRoot::max_steps`]).
+#[inline(always)]
+fn drive<S: Machine, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
+    state: &mut S,
+    mem: &M,
+    ctx: &RayContext<T>,
+    q: &mut QueryState,
+    obs: &mut O,
+    max_steps: u32,
+) {
+    let mut budget = max_steps;
+    while state.step(mem, ctx, q, obs) != Step::Done && budget > 0 {
+        budget -= 1;
+    }
 }

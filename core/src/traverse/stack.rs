@@ -27,6 +27,15 @@ impl<const DISJOINT: bool> StackState<DISJOINT> {
         Self { addr: root, len: 0, stack: [NodeRef::NONE; CAPACITY], disjoint: 0 }
     }
 
+    /// Starts over at `root` for another ray. The stack's storage is kept as it is: entries above
+    /// its top are never read, so a batch sets the stack up once rather than once per ray.
+    #[inline(always)]
+    pub fn restart(&mut self, root: NodeRef) {
+        self.addr = root;
+        self.len = 0;
+        self.disjoint = 0;
+    }
+
     /// Processes one node; see [`Step`].
     #[inline(always)]
     pub fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
@@ -42,7 +51,7 @@ impl<const DISJOINT: bool> StackState<DISJOINT> {
         }
         obs.node(self.addr);
         if !self.addr.is_leaf() {
-            let node = mem.node(self.addr.index());
+            let node = mem.read_node(self.addr.index());
             match order_children(&node, ctx, q.limit()) {
                 Descent::One(i) => {
                     self.addr = node.children[i];

@@ -1,6 +1,8 @@
-//! The `raytrail` command line: the main job (no arguments), `trace`, and `rays`.
+//! The `raytrail` command line: the main job (no arguments), `trace`, `rays` and `bench`.
 
 mod args;
+mod bench;
+mod gpu;
 mod progress;
 mod run;
 mod trace;
@@ -11,15 +13,24 @@ raytrail: ray-traversal methods for triangle scenes
 USAGE:
   raytrail                      the main job on the built-in scene (same as `raytrail run`)
   raytrail run [--scene FILE] [--builder sah|ploc] [--width W] [--height H] [--passes N]
-               [--threads N] [--check-rays N]
+               [--threads N] [--check-rays N] [--no-gpu]
       builds the BVH, derives layouts and hash tables, traces primary, shadow and diffuse rays
-      with every method, and prints Mrays/s, work per ray, state size and the conformance verdict
+      with every method on the CPU and, when wgpu finds an adapter, on the GPU, and prints
+      Mrays/s, work per ray, state size and the conformance verdict
   raytrail trace --scene FILE --rays RAYS.npy --method NAME --out HITS.npy [--any]
                [--builder sah|ploc] [--moller-trumbore]
       traces a NumPy ray file (float32, shape (N, 8): origin xyz, tmin, dir xyz, tmax) into a hit
       file (fields t <f4, prim <u4, u <f4, v <f4; a miss has t = inf, prim = 0xFFFFFFFF)
   raytrail rays --scene FILE --out RAYS.npy [--width W] [--height H]
       writes primary rays (Morton order) framing the scene, for `trace`
+  raytrail bench [--scene FILE[,FILE...]] [--rays primary,shadow,diffuse,ao] [--width W] [--height H]
+               [--passes N] [--threads N[,N...]] [--methods NAME,...|all|none] [--peers NAME,...|all|none]
+               [--baseline NAME] [--builder sah|ploc] [--ao-rays N] [--json FILE] [--plot FILE.svg]
+      times raytrail's methods and the peers (obvhs-bvh2, obvhs-cwbvh, bvh; each also as NAME+wt with
+      raytrail's watertight test) on the same rays on the same thread pool; prints Mrays/s (median of
+      N passes, default 5, after a warm-up), the ratio to the baseline (default obvhs-bvh2), work per
+      ray, build times, memory and hit agreement with the stack method. Defaults: 512 x 512 primary
+      rays, 4 ambient-occlusion rays per hit, 1 thread and all threads, every method and peer
 
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
          kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree)
@@ -40,6 +51,7 @@ fn main() {
         "run" => run::main(rest),
         "trace" => trace::main(rest),
         "rays" => trace::rays_main(rest),
+        "bench" => bench::main(rest),
         other => Err(format!("unknown command '{other}'\n\n{USAGE}")),
     };
     match result {

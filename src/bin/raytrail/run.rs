@@ -14,10 +14,20 @@ use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::{load_scene, Builder, BUILTIN_SCENE};
 use std::sync::Arc;
 
-const FLAGS: &[&str] = &["scene", "builder", "width", "height", "passes", "threads", "check-rays"];
+const FLAGS: &[&str] = &["scene", "builder", "width", "height", "passes", "threads", "check-rays", "no-gpu"];
 
 /// One method's figures on a ray set: median seconds and counters.
 type Row = (Method, f64, Counters);
+
+/// One ray set's results: rows, rays checked, CPU mismatches, GPU seconds per method and GPU
+/// mismatches (when the GPU ran).
+struct SetResult<'a> {
+    set: &'a RaySetRun,
+    rows: Vec<Row>,
+    checked: usize,
+    mismatches: Vec<Mismatch>,
+    gpu: Option<(Vec<f64>, Vec<Mismatch>)>,
+}
 
 struct RaySetRun {
     name: &'static str,
@@ -26,7 +36,7 @@ struct RaySetRun {
 }
 
 pub fn main(args: &[String]) -> Result<i32, String> {
-    let a = Args::parse(args, &[])?;
+    let a = Args::parse(args, &["no-gpu"])?;
     a.only(FLAGS)?;
     let scene_arg = a.get("scene").unwrap_or(BUILTIN_SCENE);
     let builder = Builder::from_name(a.get("builder").unwrap_or("sah"))?;
@@ -52,11 +62,18 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     print_scene(&named.name, builder, build_s, &prepared);
 
     let cpu = backend.prepare(prepared.clone()).map_err(|e| e.to_string())?;
+    let gpu = if a.has("no-gpu") { Err("--no-gpu".to_string()) } else { crate::gpu::Gpu::open(prepared.clone()) };
+    match &gpu {
+        Ok(g) => println!("  GPU: {}", g.describe()),
+        Err(why) => println!("  GPU: skipped ({why}); the CPU figures follow"),
+    }
+    let gpu = gpu.ok();
     let sets = ray_sets(&backend, &cpu, scene, width, height)?;
     let depth = prepared.bvh.stats().depth;
     let key_bytes = prepared.key_width().bytes();
     let mut failures: Vec<Mismatch> = Vec::new();
-    let mut progress = Progress::new("tracing", sets.len() * Method::ALL.len() * (passes + 1) + sets.len());
+    let gpu_steps = if gpu.is_some() { sets.len() * (Method::ALL.len() + 1) } else { 0 };
+    let mut progress = Progress::new("tracing", sets.len() * Method::ALL.len() * (passes + 1) + sets.len() + gpu_steps);
     let mut tables = Vec::new();
     for set in &sets {
         let mut rows = Vec::new();
@@ -85,19 +102,35 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         let ctx = Context { scene: &named.name, ray_set: set.name, backend: backend.name() };
         let mismatches = check_ray_set(&backend, &cpu, ctx, &subset, &Method::ALL).map_err(|e| e.to_string())?;
         progress.step(&format!("{} conformance", set.name));
-        tables.push((set, rows, subset.len(), mismatches.clone()));
-        failures.extend(mismatches);
+        failures.extend(mismatches.clone());
+        let gpu_result = match &gpu {
+            Some(g) => {
+                let mut secs = Vec::new();
+                for method in Method::ALL {
+                    secs.push(g.time(&set.rays, method, set.query, passes)?);
+                    progress.step(&format!("{} {} on the GPU", set.name, method));
+                }
+                let ctx = Context { scene: &named.name, ray_set: set.name, backend: "wgpu" };
+                let gm = g.check(&backend, &cpu, ctx, &subset)?;
+                progress.step(&format!("{} GPU conformance", set.name));
+                failures.extend(gm.clone());
+                Some((secs, gm))
+            }
+            None => None,
+        };
+        tables.push(SetResult { set, rows, checked: subset.len(), mismatches, gpu: gpu_result });
     }
     progress.finish();
-    for (set, rows, checked, mismatches) in &tables {
-        print_table(set, rows, *checked, mismatches, depth, key_bytes);
+    for t in &tables {
+        print_table(t, depth, key_bytes);
     }
-    let per_set: Vec<(&str, Vec<Row>)> = tables.iter().map(|(s, rows, ..)| (s.name, rows.clone())).collect();
+    let per_set: Vec<(&str, Vec<Row>)> = tables.iter().map(|t| (t.set.name, t.rows.clone())).collect();
     print_backtracking(&per_set);
     print_kd(&per_set);
     if failures.is_empty() {
         println!(
-            "\nconformance: every method matches its reference on every checked ray (hits and node enumerations)."
+            "\nconformance: every method matches its reference on every checked ray (hits and node enumerations){}.",
+            if gpu.is_some() { ", on the GPU as on the CPU, and the GPU matches the CPU ray by ray" } else { "" }
         );
         Ok(0)
     } else {
@@ -186,23 +219,32 @@ fn per_ray(x: u64, c: &Counters) -> f64 {
     x as f64 / c.rays.max(1) as f64
 }
 
-fn print_table(set: &RaySetRun, rows: &[Row], checked: usize, mismatches: &[Mismatch], depth: u32, key_bytes: usize) {
+fn print_table(t: &SetResult<'_>, depth: u32, key_bytes: usize) {
+    let set = t.set;
     println!(
         "\n{} rays: {} ({} hit), median of timed passes; conformance on {} rays",
         set.name,
         set.rays.len(),
         set.query.name(),
-        checked
+        t.checked
     );
+    let gpu_head = if t.gpu.is_some() { format!(" {:>9}", "GPU Mr/s") } else { String::new() };
     println!(
-        "  {:<15} {:>9} {:>10} {:>10} {:>12} {:>10} {:>10} {:>8}  conformance",
+        "  {:<15} {:>9} {:>10}{gpu_head} {:>10} {:>12} {:>10} {:>10} {:>8}  conformance",
         "method", "Mrays/s", "vs stack", "nodes/ray", "backtr./ray", "hash/ray", "links/ray", "state B"
     );
-    let stack_s = rows.iter().find(|r| r.0 == Method::Stack).map_or(0.0, |r| r.1);
-    for (m, secs, c) in rows {
-        let bad = mismatches.iter().filter(|x| x.method == *m).count();
+    let stack_s = t.rows.iter().find(|r| r.0 == Method::Stack).map_or(0.0, |r| r.1);
+    for (i, (m, secs, c)) in t.rows.iter().enumerate() {
+        let mut bad = t.mismatches.iter().filter(|x| x.method == *m).count();
+        let gpu_col = match &t.gpu {
+            Some((secs, gm)) => {
+                bad += gm.iter().filter(|x| x.method == *m).count();
+                format!(" {:>9.2}", set.rays.len() as f64 / secs[i] / 1e6)
+            }
+            None => String::new(),
+        };
         println!(
-            "  {:<15} {:>9.2} {:>9.2}x {:>10.1} {:>12.2} {:>10.2} {:>10.2} {:>8}  {}",
+            "  {:<15} {:>9.2} {:>9.2}x{gpu_col} {:>10.1} {:>12.2} {:>10.2} {:>10.2} {:>8}  {}",
             m.name(),
             set.rays.len() as f64 / secs / 1e6,
             stack_s / secs,

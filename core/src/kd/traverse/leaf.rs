@@ -25,8 +25,10 @@ pub fn kd_leaf<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
     for i in node.first()..node.first() + node.count() {
         let prim = mem.prim_ref(i);
         obs.primitive(prim);
-        let [a, b, c] = mem.triangle(prim);
-        if let Some(h) = T::intersect(&ctx.tri, a, b, c, ctx.ray.tmin, q.limit()) {
+        let tri = mem.read_triangle(prim);
+        let [a, b, c] = &*tri;
+        if let Some(h) = T::intersect_in_place(&ctx.tri, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit())
+        {
             if q.offer(h, prim) {
                 obs.hit(prim, h.t);
                 if q.any {

@@ -1,0 +1,213 @@
+//! Shader composition: which WGSL files make a kernel, and the constants shared with the core.
+//!
+//! A kernel is specialized twice over, so a scene pays only for what it uses:
+//! - by composition, for what changes types or pulls in code: the method file, the triangle test,
+//!   the key width (`u32`, or a pair of `u32` standing in for `u64`) and the hash tables;
+//! - by override constants, for switches the compiler folds away: any hit, recording, the
+//!   disjoint-interval mask.
+
+use raytrail_core::intersect::{FAR_PAD, RELIABLE_LIMIT, SLACK_ULPS};
+use raytrail_core::kd::traverse::{PACKET_WIDTH, SHORT_STACK_MAX};
+use raytrail_core::key::KeyWidth;
+use raytrail_core::trace::{Record, TriangleTestKind};
+use raytrail_core::traverse::{Method, Query};
+
+/// One WGSL file of `shaders/`, by name and text.
+type Part = (&'static str, &'static str);
+
+macro_rules! part {
+    ($name:literal) => {
+        ($name, include_str!(concat!("../../../shaders/", $name)))
+    };
+}
+
+const PRELUDE: Part = part!("prelude.wgsl");
+const NUMERICS: Part = part!("numerics.wgsl");
+const BOX: Part = part!("box.wgsl");
+const WATERTIGHT: Part = part!("triangle_watertight.wgsl");
+const MOLLER_TRUMBORE: Part = part!("triangle_moller_trumbore.wgsl");
+const QUERY: Part = part!("query.wgsl");
+const RECORD: Part = part!("record.wgsl");
+const BVH_LEAF: Part = part!("bvh_leaf.wgsl");
+const BVH_STACK: Part = part!("bvh_stack.wgsl");
+const KEYS32: Part = part!("keys32.wgsl");
+const KEYS64: Part = part!("keys64.wgsl");
+const HASH: Part = part!("hash.wgsl");
+const BVH_PARENT_SIBLING: Part = part!("bvh_parent_sibling.wgsl");
+const BVH_REGISTER: Part = part!("bvh_register.wgsl");
+const FALLBACK_UNCLE: Part = part!("fallback_uncle.wgsl");
+const FALLBACK_HASH: Part = part!("fallback_hash.wgsl");
+const BVH_RUN: Part = part!("bvh_register_run.wgsl");
+const BVH_RESUME: Part = part!("bvh_resume.wgsl");
+const KD_COMMON: Part = part!("kd_common.wgsl");
+const KD_STACK: Part = part!("kd_stack.wgsl");
+const KD_RESTART: Part = part!("kd_restart.wgsl");
+const KD_PACKET: Part = part!("kd_packet.wgsl");
+const ENTRY: Part = part!("entry.wgsl");
+
+/// Everything that selects a kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Variant {
+    /// The traversal method.
+    pub method: Method,
+    /// Key and trail width of the tree (BVH2 stackless methods).
+    pub keys: KeyWidth,
+    /// The triangle test.
+    pub triangle: TriangleTestKind,
+    /// Closest or any hit.
+    pub query: Query,
+    /// What is recorded.
+    pub record: Record,
+}
+
+impl Variant {
+    /// The variant's name, for labels and messages.
+    pub fn label(&self) -> String {
+        format!(
+            "{}/{}/{}/{}/{:?}",
+            self.method.name(),
+            if self.keys == KeyWidth::W64 { "k64" } else { "k32" },
+            match self.triangle {
+                TriangleTestKind::Watertight => "watertight",
+                TriangleTestKind::MollerTrumbore => "moller-trumbore",
+            },
+            self.query.name(),
+            self.record
+        )
+    }
+
+    /// The WGSL files of this kernel, in order.
+    pub fn parts(&self) -> Vec<Part> {
+        let triangle = match self.triangle {
+            TriangleTestKind::Watertight => WATERTIGHT,
+            TriangleTestKind::MollerTrumbore => MOLLER_TRUMBORE,
+        };
+        let keys = if self.keys == KeyWidth::W64 { KEYS64 } else { KEYS32 };
+        let mut parts = vec![PRELUDE, NUMERICS, BOX, triangle, QUERY, RECORD];
+        let method: &[Part] = match self.method {
+            Method::Stack | Method::StackDisjoint => &[BVH_LEAF, BVH_STACK],
+            Method::ParentSibling => &[BVH_LEAF, keys, BVH_PARENT_SIBLING],
+            Method::Uncle => &[BVH_LEAF, keys, FALLBACK_UNCLE, BVH_REGISTER, BVH_RUN],
+            Method::Hash | Method::HashDisjoint => &[BVH_LEAF, keys, HASH, FALLBACK_HASH, BVH_REGISTER, BVH_RUN],
+            Method::HashResume => &[BVH_LEAF, keys, HASH, FALLBACK_HASH, BVH_REGISTER, BVH_RESUME],
+            Method::KdStack => &[KD_COMMON, KD_STACK],
+            Method::KdRestart | Method::KdPushDown | Method::KdShortStack => &[KD_COMMON, KD_RESTART],
+            Method::KdPacket => &[KD_COMMON, KD_PACKET],
+        };
+        parts.extend_from_slice(method);
+        // A packet kernel has its own entry point: one invocation per packet of rays.
+        if self.method != Method::KdPacket {
+            parts.push(ENTRY);
+        }
+        parts
+    }
+
+    /// The full WGSL source: the generated constants, then the parts.
+    pub fn source(&self) -> String {
+        let mut s = constants_header(self.method);
+        for (name, text) in self.parts() {
+            s.push_str(&format!("\n// ---- shaders/{name} ----\n"));
+            s.push_str(text);
+        }
+        s
+    }
+
+    /// Values of the override constants.
+    pub fn overrides(&self) -> Vec<(&'static str, f64)> {
+        let record = match self.record {
+            Record::Nothing => 0.0,
+            Record::Counters => 1.0,
+            Record::Enumerations => 2.0,
+        };
+        let disjoint = matches!(self.method, Method::StackDisjoint | Method::HashDisjoint);
+        vec![
+            ("ANY_HIT", f64::from(u8::from(self.query == Query::Any))),
+            ("RECORD", record),
+            ("DISJOINT", f64::from(u8::from(disjoint))),
+        ]
+    }
+}
+
+/// Constants the shaders must share with the core bit for bit, written from the core's own
+/// values rather than retyped as WGSL literals (which a compiler would round its own way).
+fn constants_header(method: Method) -> String {
+    let kd_mode = match method {
+        Method::KdRestart => 0,
+        Method::KdPushDown => 1,
+        _ => 2,
+    };
+    format!(
+        "// Generated by backends/wgpu/src/compose.rs from raytrail-core's constants.\n\
+         const FAR_PAD_BITS: u32 = {:#010x}u;\n\
+         const SLACK_SCALE_BITS: u32 = {:#010x}u;\n\
+         const RELIABLE_LIMIT_BITS: u32 = {:#010x}u;\n\
+         // kd restart family: 0 restart, 1 push-down, 2 short stack.\n\
+         const KD_MODE: u32 = {kd_mode}u;\n\
+         const SHORT_STACK_MAX: u32 = {SHORT_STACK_MAX}u;\n\
+         const PACKET_WIDTH: u32 = {PACKET_WIDTH}u;\n",
+        FAR_PAD.to_bits(),
+        (SLACK_ULPS * f32::EPSILON).to_bits(),
+        RELIABLE_LIMIT.to_bits(),
+    )
+}
+
+/// Every variant a scene with keys of width `keys` can ask for.
+pub fn all_variants(keys: KeyWidth) -> impl Iterator<Item = Variant> {
+    Method::ALL.into_iter().flat_map(move |method| {
+        [TriangleTestKind::Watertight, TriangleTestKind::MollerTrumbore].into_iter().flat_map(move |triangle| {
+            [Query::Closest, Query::Any].into_iter().flat_map(move |query| {
+                [Record::Nothing, Record::Counters, Record::Enumerations].into_iter().map(move |record| Variant {
+                    method,
+                    keys,
+                    triangle,
+                    query,
+                    record,
+                })
+            })
+        })
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// naga as wgpu runs it: parse, then validate with the capabilities the backend requests.
+    fn validate(v: &Variant) -> Result<(), String> {
+        let src = v.source();
+        let module = naga::front::wgsl::parse_str(&src).map_err(|e| e.emit_to_string(&src))?;
+        let caps = naga::valid::Capabilities::FLOAT64;
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
+            .validate(&module)
+            .map_err(|e| e.emit_to_string(&src))?;
+        Ok(())
+    }
+
+    #[test]
+    fn every_composition_parses_and_validates_without_an_adapter() {
+        let mut failures = Vec::new();
+        let mut n = 0;
+        for keys in [KeyWidth::W32, KeyWidth::W64] {
+            for v in all_variants(keys) {
+                n += 1;
+                if let Err(e) = validate(&v) {
+                    failures.push(format!("{}:\n{e}", v.label()));
+                }
+            }
+        }
+        assert!(
+            failures.is_empty(),
+            "{} of {n} kernels fail naga validation:\n{}",
+            failures.len(),
+            failures.join("\n")
+        );
+        assert_eq!(n, 2 * 12 * 2 * 2 * 3);
+    }
+
+    #[test]
+    fn constants_are_the_cores_bits() {
+        let h = constants_header(Method::Stack);
+        assert!(h.contains(&format!("{:#010x}", FAR_PAD.to_bits())));
+        assert_eq!((SLACK_ULPS * f32::EPSILON).to_bits(), (1.0f32 / 131072.0).to_bits());
+    }
+}

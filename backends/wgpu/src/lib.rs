@@ -1,0 +1,30 @@
+//! raytrail-wgpu: the wgpu backend of raytrail.
+//!
+//! [`WgpuBackend`] implements the backend-agnostic [`Trace`](raytrail_core::trace::Trace) trait
+//! with WGSL compute kernels (one invocation per ray; one per packet of four rays for kd-packet),
+//! composed from the files in `shaders/` and specialized per method, key width, triangle test,
+//! query and recording ([`compose`]). Each kernel mirrors its core state machine transition for
+//! transition, and its arithmetic is written to come out bit for bit as on the CPU whatever the
+//! shader compiler does (NUMERICS.md in this crate says how).
+//!
+//! Without an adapter, [`WgpuBackend::new`] returns an error naming why; callers (the CLI, the
+//! conformance suite) then go on with the CPU backend.
+#![warn(missing_docs)]
+
+mod backend;
+mod batch;
+pub mod compose;
+mod device;
+mod packets;
+mod params;
+mod pipelines;
+mod probe;
+mod record;
+mod scene;
+
+pub use backend::WgpuBackend;
+pub use probe::NumericsProbe;
+pub use scene::WgpuScene;
+
+/// Environment variable that turns a missing adapter from a skip into a failure (CI sets it).
+pub const REQUIRE_GPU: &str = "RAYTRAIL_REQUIRE_GPU";

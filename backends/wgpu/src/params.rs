@@ -1,0 +1,35 @@
+//! The uniform block every kernel reads (`Params` in shaders/prelude.wgsl).
+
+use bytemuck::{Pod, Zeroable};
+
+/// Per-batch and per-scene constants, laid out as the WGSL struct (96 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(crate) struct Params {
+    pub ray_count: u32,
+    pub row_width: u32,
+    pub root: u32,
+    pub max_steps: u32,
+    pub scene_scale: f32,
+    /// Always 0; the shaders' opaque zero (see NUMERICS.md).
+    pub zero: u32,
+    pub d_mask: u32,
+    pub h: u32,
+    pub leaf_base: u32,
+    pub record_stride: u32,
+    pub record_cap: u32,
+    pub short_stack: u32,
+    pub kd_prims: u32,
+    pub kd_tris: u32,
+    pub pad: [u32; 2],
+    pub kd_lo: [f32; 4],
+    pub kd_hi: [f32; 4],
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn params_match_the_wgsl_size() {
+        assert_eq!(core::mem::size_of::<super::Params>(), 96);
+    }
+}

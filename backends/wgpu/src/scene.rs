@@ -1,0 +1,147 @@
+//! A prepared scene on the device: each layout and table the scene was prepared with, uploaded
+//! once, and nothing it was not.
+
+use crate::device::{device_error, Gpu};
+use raytrail_core::bvh2::BinaryLayout;
+use raytrail_core::prepared::{BuiltHash, PreparedBvh2};
+use raytrail_core::traverse::Method;
+use raytrail_core::Error;
+use std::sync::Arc;
+use wgpu::util::DeviceExt;
+
+/// A BVH2 layout on the device: internal nodes, then the leaf array.
+pub(crate) struct LayoutBuffer {
+    pub buffer: wgpu::Buffer,
+    /// Where the leaf array starts, in 16-byte words.
+    pub leaf_base: u32,
+}
+
+/// Hash tables on the device: displacements, then cells.
+pub(crate) struct HashBuffer {
+    pub buffer: wgpu::Buffer,
+    pub d_mask: u32,
+    pub h: u32,
+}
+
+/// The kd-tree on the device: nodes, references, triangles.
+pub(crate) struct KdBuffer {
+    pub buffer: wgpu::Buffer,
+    pub prims: u32,
+    pub tris: u32,
+}
+
+/// A scene as the wgpu backend holds it.
+pub struct WgpuScene {
+    /// The prepared scene (the host side: roots, layouts for canonical ids, key width).
+    pub prepared: Arc<PreparedBvh2>,
+    pub(crate) uncles: Option<LayoutBuffer>,
+    pub(crate) parents: Option<LayoutBuffer>,
+    pub(crate) hash: Option<HashBuffer>,
+    pub(crate) full_hash: Option<HashBuffer>,
+    pub(crate) kd: Option<KdBuffer>,
+    /// A small buffer bound where a kernel's unused bindings would be.
+    pub(crate) empty: wgpu::Buffer,
+}
+
+fn storage(gpu: &Gpu, label: &str, words: &[u32]) -> Result<wgpu::Buffer, Error> {
+    let bytes = (words.len() as u64) * 4;
+    if bytes > gpu.limits.max_storage_buffer_binding_size || bytes > gpu.limits.max_buffer_size {
+        return Err(device_error(format!(
+            "{label} needs {bytes} bytes, above the adapter's storage binding limit of {} bytes",
+            gpu.limits.max_storage_buffer_binding_size
+        )));
+    }
+    // Bindings must not be empty.
+    let padded;
+    let contents: &[u32] = if words.is_empty() {
+        padded = [0u32; 4];
+        &padded
+    } else {
+        words
+    };
+    gpu.checked(label, || {
+        gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(contents),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+    })
+}
+
+fn layout(gpu: &Gpu, label: &str, l: &BinaryLayout) -> Result<LayoutBuffer, Error> {
+    let mut words: Vec<u32> = Vec::with_capacity(l.nodes.len() * 16 + l.leaves.len() * 4);
+    words.extend_from_slice(bytemuck::cast_slice(&l.nodes));
+    words.extend_from_slice(bytemuck::cast_slice(&l.leaves));
+    let leaf_base = u32::try_from(l.nodes.len() * 4)
+        .map_err(|_| device_error(format!("{label}: {} nodes exceed 32-bit word offsets", l.nodes.len())))?;
+    Ok(LayoutBuffer { buffer: storage(gpu, label, &words)?, leaf_base })
+}
+
+fn hash(gpu: &Gpu, label: &str, h: &BuiltHash) -> Result<HashBuffer, Error> {
+    let t = &h.tables;
+    let mut words: Vec<u32> = Vec::with_capacity(t.displacement.len() + t.cells.len());
+    words.extend(t.displacement.iter().map(|&d| d as u32));
+    words.extend_from_slice(&t.cells);
+    Ok(HashBuffer { buffer: storage(gpu, label, &words)?, d_mask: t.shape.d_mask, h: t.shape.h })
+}
+
+impl WgpuScene {
+    /// Uploads what `prepared` holds.
+    pub(crate) fn upload(gpu: &Gpu, prepared: Arc<PreparedBvh2>) -> Result<WgpuScene, Error> {
+        let p = &prepared;
+        let uncles = p.uncles.as_ref().map(|l| layout(gpu, "uncle layout", l)).transpose()?;
+        let parents = p.parents.as_ref().map(|l| layout(gpu, "parent/sibling layout", l)).transpose()?;
+        let hash_tables = p.hash.as_ref().map(|h| hash(gpu, "hash tables", h)).transpose()?;
+        let full_hash = p.full_hash.as_ref().map(|h| hash(gpu, "full hash tables", h)).transpose()?;
+        let kd = match &p.kd {
+            None => None,
+            Some(kd) => {
+                let nodes: &[u32] = bytemuck::cast_slice(kd.tree.nodes());
+                let prims = kd.tree.prims();
+                let mut words = Vec::with_capacity(nodes.len() + prims.len() + kd.triangles.len() * 9);
+                words.extend_from_slice(nodes);
+                words.extend_from_slice(prims);
+                words.extend(kd.triangles.iter().flat_map(|t| t.v).flat_map(|v| v.to_array()).map(f32::to_bits));
+                let too_big = |_| device_error("the kd-tree exceeds 32-bit word offsets");
+                Some(KdBuffer {
+                    buffer: storage(gpu, "kd-tree", &words)?,
+                    prims: u32::try_from(nodes.len()).map_err(too_big)?,
+                    tris: u32::try_from(nodes.len() + prims.len()).map_err(too_big)?,
+                })
+            }
+        };
+        let empty = storage(gpu, "empty", &[])?;
+        Ok(WgpuScene { prepared, uncles, parents, hash: hash_tables, full_hash, kd, empty })
+    }
+
+    /// The layout buffer `method` reads.
+    pub(crate) fn layout_for(&self, method: Method) -> Option<&LayoutBuffer> {
+        if method.needs_parent_links() {
+            self.parents.as_ref()
+        } else {
+            self.uncles.as_ref()
+        }
+    }
+
+    /// The hash buffer `method` reads, if any.
+    pub(crate) fn hash_for(&self, method: Method) -> Option<&HashBuffer> {
+        if method.needs_full_hash() {
+            self.full_hash.as_ref()
+        } else if method.needs_hash() {
+            self.hash.as_ref()
+        } else {
+            None
+        }
+    }
+
+    /// Bytes on the device.
+    pub fn device_bytes(&self) -> u64 {
+        let l = |b: &Option<LayoutBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
+        let h = |b: &Option<HashBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
+        l(&self.uncles)
+            + l(&self.parents)
+            + h(&self.hash)
+            + h(&self.full_hash)
+            + self.kd.as_ref().map_or(0, |k| k.buffer.size())
+    }
+}

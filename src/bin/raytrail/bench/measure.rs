@@ -1,0 +1,99 @@
+//! Timing: every target on every ray batch at every thread count, passes interleaved.
+//!
+//! Per batch and thread count, each target first traces once untimed (the warm-up; at the first
+//! thread count its hits are also compared with the reference). Then come the timed passes,
+//! round-robin: pass 1 of every target, then pass 2 of every target, and so on, so that a slow
+//! spell of the shared machine spreads over all targets instead of hitting one. A target's speed
+//! is the median of its passes, timed by the wall clock around its trace call (GPU targets with
+//! timestamp queries time themselves). Work per ray is
+//! counted in one more untimed pass, on the largest pool.
+
+use super::agreement::{compare, Agreement};
+use super::rays::RayBatch;
+use super::report::{median, RayReport, Row};
+use super::target::BenchTarget;
+use crate::progress::Progress;
+use raytrail::core::geometry::Triangle;
+use raytrail::core::Hit;
+use std::time::Instant;
+
+/// The fixed inputs of one scene's measurements.
+pub struct Plan<'a> {
+    /// Targets, in report order.
+    pub targets: &'a [Box<dyn BenchTarget>],
+    /// Thread pools with their thread counts, ascending.
+    pub pools: &'a [(usize, rayon::ThreadPool)],
+    /// Timed passes per measurement.
+    pub passes: usize,
+    /// Target the ratio divides by.
+    pub baseline: &'a str,
+    /// The scene's triangles (to classify disagreements).
+    pub triangles: &'a [Triangle],
+}
+
+impl Plan<'_> {
+    /// Progress steps [`Plan::run`] takes for one batch.
+    pub fn steps_per_batch(&self) -> usize {
+        self.targets.len() * (self.pools.len() * (1 + self.passes) + 1)
+    }
+
+    /// Measures every target on `batch`, comparing hits with `reference` (the stack method's).
+    pub fn run(&self, batch: &RayBatch, reference: &[Hit], progress: &mut Progress) -> Result<RayReport, String> {
+        let (rays, query, kind) = (&batch.rays, batch.kind.query(), batch.kind.name());
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let mut agreement: Vec<(String, Agreement)> = Vec::new();
+        let mut rows = Vec::new();
+        for (p, (threads, pool)) in self.pools.iter().enumerate() {
+            for t in self.targets {
+                t.trace(pool, rays, query, &mut hits)?;
+                if p == 0 {
+                    agreement.push((t.name().to_string(), compare(query, rays, reference, &hits, self.triangles)));
+                }
+                progress.step(&format!("{kind} {} warm-up, {threads} thr", t.name()));
+            }
+            let mut times = vec![Vec::with_capacity(self.passes); self.targets.len()];
+            for pass in 0..self.passes {
+                for (t, secs) in self.targets.iter().zip(&mut times) {
+                    let start = Instant::now();
+                    let own = t.trace_timed(pool, rays, query, &mut hits)?;
+                    secs.push(own.unwrap_or_else(|| start.elapsed().as_secs_f64()));
+                    progress.step(&format!("{kind} {} pass {}, {threads} thr", t.name(), pass + 1));
+                }
+            }
+            for (t, passes) in self.targets.iter().zip(times) {
+                let median_s = median(&passes);
+                let mrays_per_s = if median_s > 0.0 { rays.len() as f64 / median_s / 1e6 } else { 0.0 };
+                rows.push(Row {
+                    target: t.name().to_string(),
+                    kind: t.kind(),
+                    threads: *threads,
+                    passes,
+                    median_s,
+                    mrays_per_s,
+                    ratio: None,
+                    work: None,
+                });
+            }
+        }
+        if let Some((_, pool)) = self.pools.last() {
+            for t in self.targets {
+                let work = t.work(pool, rays, query)?;
+                for r in rows.iter_mut().filter(|r| r.target == t.name()) {
+                    r.work = work;
+                }
+                progress.step(&format!("{kind} {} work", t.name()));
+            }
+        }
+        set_ratios(&mut rows, self.baseline);
+        Ok(RayReport { kind: batch.kind, rays: rays.len(), rows, agreement })
+    }
+}
+
+/// Sets each row's ratio to the baseline's speed at the same thread count.
+fn set_ratios(rows: &mut [Row], baseline: &str) {
+    let base: Vec<(usize, f64)> =
+        rows.iter().filter(|r| r.target == baseline).map(|r| (r.threads, r.mrays_per_s)).collect();
+    for r in rows {
+        r.ratio = base.iter().find(|b| b.0 == r.threads && b.1 > 0.0).map(|b| r.mrays_per_s / b.1);
+    }
+}

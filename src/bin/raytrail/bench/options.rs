@@ -1,0 +1,225 @@
+//! The `raytrail bench` flags, parsed and checked before any work starts.
+
+use super::rays::RayKind;
+use crate::args::Args;
+use raytrail::core::traverse::Method;
+use raytrail::{Builder, BUILTIN_SCENE};
+
+/// Every flag `raytrail bench` knows.
+const FLAGS: &[&str] = &[
+    "scene", "rays", "width", "height", "passes", "threads", "methods", "peers", "baseline", "json", "plot", "builder",
+    "ao-rays", "no-gpu",
+];
+
+/// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
+/// follow from the primary hits). With the three scenes of BENCHMARKS.md (Sponza, the kitchen, the
+/// full dragon), every target at 1 and 2 threads, the run takes about five minutes on the project's
+/// shared 2-core machine.
+pub const DEFAULT_SIZE: u32 = 512;
+
+/// Default number of timed passes: the median of five rides out most of the shared machine's noise.
+pub const DEFAULT_PASSES: usize = 5;
+
+/// Default number of ambient-occlusion rays per primary hit.
+pub const DEFAULT_AO_RAYS: usize = 4;
+
+/// The peers a run can include, by command-line name.
+pub const PEERS: [&str; 3] = ["obvhs-bvh2", "obvhs-cwbvh", "bvh"];
+
+/// What to measure, and where to write it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// Scene files (or `builtin`), in order.
+    pub scenes: Vec<String>,
+    /// Ray types, in order.
+    pub rays: Vec<RayKind>,
+    /// Primary image width.
+    pub width: u32,
+    /// Primary image height.
+    pub height: u32,
+    /// Timed passes per measurement (after one warm-up pass).
+    pub passes: usize,
+    /// Thread counts to measure, ascending.
+    pub threads: Vec<usize>,
+    /// raytrail methods to measure.
+    pub methods: Vec<Method>,
+    /// Peers to measure (names from [`PEERS`]).
+    pub peers: Vec<String>,
+    /// Target whose speed the ratio column divides by.
+    pub baseline: String,
+    /// Where to write JSON, if anywhere.
+    pub json: Option<String>,
+    /// Where to write the SVG plot, if anywhere.
+    pub plot: Option<String>,
+    /// Builder of raytrail's canonical tree.
+    pub builder: Builder,
+    /// Ambient-occlusion rays per primary hit.
+    pub ao_rays: usize,
+    /// Leave the GPU out even when wgpu finds an adapter.
+    pub no_gpu: bool,
+}
+
+impl Options {
+    /// Parses and checks the flags after `raytrail bench`.
+    pub fn parse(args: &[String]) -> Result<Options, String> {
+        let a = Args::parse(args, &["no-gpu"])?;
+        a.only(FLAGS)?;
+        let scenes = list(a.get("scene").unwrap_or(BUILTIN_SCENE));
+        if scenes.is_empty() {
+            return Err("--scene: no scene given".to_string());
+        }
+        let rays = match a.get("rays") {
+            None => RayKind::ALL.to_vec(),
+            Some(v) => unique(
+                list(v)
+                    .iter()
+                    .map(|n| {
+                        RayKind::from_name(n).ok_or_else(|| {
+                            format!(
+                                "--rays: unknown ray type '{n}' (known: {})",
+                                RayKind::ALL.map(RayKind::name).join(", ")
+                            )
+                        })
+                    })
+                    .collect::<Result<_, _>>()?,
+            ),
+        };
+        let methods = match a.get("methods") {
+            None | Some("all") => Method::ALL.to_vec(),
+            Some("none") => Vec::new(),
+            Some(v) => unique(
+                list(v)
+                    .iter()
+                    .map(|n| {
+                        Method::from_name(n).ok_or_else(|| {
+                            format!(
+                                "--methods: unknown method '{n}' (known: {})",
+                                Method::ALL.map(Method::name).join(", ")
+                            )
+                        })
+                    })
+                    .collect::<Result<_, _>>()?,
+            ),
+        };
+        let peers = match a.get("peers") {
+            None | Some("all") => PEERS.iter().map(|p| p.to_string()).collect(),
+            Some("none") => Vec::new(),
+            Some(v) => {
+                let given = unique(list(v));
+                if let Some(bad) = given.iter().find(|p| !PEERS.contains(&p.as_str())) {
+                    return Err(format!("--peers: unknown peer '{bad}' (known: {}, all, none)", PEERS.join(", ")));
+                }
+                given
+            }
+        };
+        if rays.is_empty() || (methods.is_empty() && peers.is_empty()) {
+            return Err("nothing to measure: give at least one ray type and one method or peer".to_string());
+        }
+        let (width, height) = (a.num("width", DEFAULT_SIZE)?, a.num("height", DEFAULT_SIZE)?);
+        if width == 0 || height == 0 || u64::from(width) * u64::from(height) > 1 << 26 {
+            return Err(format!("--width/--height: {width} x {height} must be at least 1 x 1 and at most 2^26 pixels"));
+        }
+        let passes = a.num("passes", DEFAULT_PASSES)?;
+        if passes == 0 {
+            return Err("--passes must be at least 1".to_string());
+        }
+        let ao_rays = a.num("ao-rays", DEFAULT_AO_RAYS)?;
+        if ao_rays == 0 || ao_rays > 64 {
+            return Err("--ao-rays must be between 1 and 64".to_string());
+        }
+        let all = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let threads = match a.get("threads") {
+            None => unique(vec![1, all]),
+            Some(v) => {
+                let mut t: Vec<usize> = list(v)
+                    .iter()
+                    .map(|n| match n.parse::<usize>() {
+                        Ok(k) if (1..=1024).contains(&k) => Ok(k),
+                        _ => Err(format!("--threads: '{n}' is not a thread count between 1 and 1024")),
+                    })
+                    .collect::<Result<_, _>>()?;
+                t.sort_unstable();
+                t.dedup();
+                t
+            }
+        };
+        if threads.is_empty() {
+            return Err("--threads: no thread count given".to_string());
+        }
+        Ok(Options {
+            scenes,
+            rays,
+            width,
+            height,
+            passes,
+            threads,
+            methods,
+            peers,
+            baseline: a.get("baseline").unwrap_or("obvhs-bvh2").to_string(),
+            json: a.get("json").map(str::to_string),
+            plot: a.get("plot").map(str::to_string),
+            builder: Builder::from_name(a.get("builder").unwrap_or("sah"))?,
+            ao_rays,
+            no_gpu: a.has("no-gpu"),
+        })
+    }
+}
+
+/// The non-empty items of a comma-separated list, trimmed.
+fn list(v: &str) -> Vec<String> {
+    v.split(',').map(str::trim).filter(|s| !s.is_empty()).map(str::to_string).collect()
+}
+
+/// `items` without repeats, first occurrence kept.
+fn unique<T: PartialEq>(items: Vec<T>) -> Vec<T> {
+    let mut out: Vec<T> = Vec::with_capacity(items.len());
+    for i in items {
+        if !out.contains(&i) {
+            out.push(i);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(s: &str) -> Result<Options, String> {
+        Options::parse(&s.split_whitespace().map(str::to_string).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn defaults_and_lists() {
+        let o = parse("").unwrap();
+        assert_eq!(o.scenes, vec!["builtin"]);
+        assert_eq!(o.rays, RayKind::ALL.to_vec());
+        assert_eq!(o.methods.len(), 12);
+        assert_eq!(o.baseline, "obvhs-bvh2");
+        assert_eq!(o.threads[0], 1);
+        let e = parse("--scene a.obj --colour red").unwrap_err();
+        assert!(e.contains("unknown flag --colour"), "{e}");
+        let o = parse("--scene a.obj,,b.ply --rays ao,primary,ao --threads 2,1,2 --methods hash,stack").unwrap();
+        assert_eq!(o.scenes, vec!["a.obj", "b.ply"]);
+        assert_eq!(o.rays, vec![RayKind::Ao, RayKind::Primary]);
+        assert_eq!(o.threads, vec![1, 2]);
+        assert_eq!(o.methods, vec![Method::Hash, Method::Stack]);
+    }
+
+    #[test]
+    fn bad_values_are_errors() {
+        for bad in [
+            "--rays sideways",
+            "--methods fastest",
+            "--peers embree",
+            "--threads 0",
+            "--passes 0",
+            "--width 0",
+            "--builder best",
+            "--methods none --peers none",
+            "--ao-rays 0",
+        ] {
+            assert!(parse(bad).is_err(), "{bad} was accepted");
+        }
+    }
+}

@@ -1,0 +1,194 @@
+//! The bench's ray types, made once per scene: primary, shadow, diffuse and ambient occlusion.
+//!
+//! Primary, shadow and diffuse rays come from the conformance suite's generators; the
+//! ambient-occlusion generator lives here.
+
+use glam::Vec3;
+use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
+use raytrail::conformance::rng::Pcg32;
+use raytrail::core::scene::Scene;
+use raytrail::core::traverse::Query;
+use raytrail::core::{Hit, Ray};
+
+/// Length of an ambient-occlusion ray, as a fraction of the scene's diagonal.
+pub const AO_RADIUS: f32 = 0.05;
+
+/// Seed stream of the ambient-occlusion rays (distinct from the diffuse rays' [`RAY_SEED`]).
+const AO_SEED: u64 = RAY_SEED ^ 0xA0;
+
+/// A kind of ray the bench traces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum RayKind {
+    /// Camera rays in Morton order, closest hit.
+    Primary,
+    /// From primary hits to a point light, any hit.
+    Shadow,
+    /// Cosine-weighted bounces from primary hits, closest hit.
+    Diffuse,
+    /// Short cosine-weighted rays from primary hits, any hit.
+    Ao,
+}
+
+impl RayKind {
+    /// Every kind, in the order they are made and reported.
+    pub const ALL: [RayKind; 4] = [RayKind::Primary, RayKind::Shadow, RayKind::Diffuse, RayKind::Ao];
+
+    /// Command-line and report name.
+    pub fn name(self) -> &'static str {
+        match self {
+            RayKind::Primary => "primary",
+            RayKind::Shadow => "shadow",
+            RayKind::Diffuse => "diffuse",
+            RayKind::Ao => "ao",
+        }
+    }
+
+    /// The kind of a command-line name.
+    pub fn from_name(name: &str) -> Option<RayKind> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// Closest hit or any hit.
+    pub fn query(self) -> Query {
+        match self {
+            RayKind::Primary | RayKind::Diffuse => Query::Closest,
+            RayKind::Shadow | RayKind::Ao => Query::Any,
+        }
+    }
+}
+
+/// One batch of rays of one kind.
+#[derive(Clone, Debug)]
+pub struct RayBatch {
+    /// What the rays are.
+    pub kind: RayKind,
+    /// The rays.
+    pub rays: Vec<Ray>,
+}
+
+/// The requested batches, in the order of `kinds`, from the primary rays and their closest hits
+/// (`primary_hits`, traced by the caller with a reference method).
+pub fn batches(
+    kinds: &[RayKind],
+    scene: &Scene,
+    primary_rays: &[Ray],
+    primary_hits: &[Hit],
+    ao_per_hit: usize,
+) -> Vec<RayBatch> {
+    let bounds = scene.bounds();
+    kinds
+        .iter()
+        .map(|&kind| {
+            let rays = match kind {
+                RayKind::Primary => primary_rays.to_vec(),
+                RayKind::Shadow => shadow(primary_rays, primary_hits, default_light(bounds), scene_epsilon(bounds)),
+                RayKind::Diffuse => diffuse(primary_rays, primary_hits, scene, RAY_SEED),
+                RayKind::Ao => ambient_occlusion(primary_rays, primary_hits, scene, ao_per_hit, AO_SEED),
+            };
+            RayBatch { kind, rays }
+        })
+        .collect()
+}
+
+/// Primary rays framing `scene` (Morton order), as the conformance suite makes them.
+pub fn primary_rays(scene: &Scene, width: u32, height: u32) -> Vec<Ray> {
+    primary(scene, width, height)
+}
+
+/// `per_hit` ambient-occlusion rays per hit of `rays` (misses, non-finite hits and zero-area
+/// triangles skipped), grouped by primary ray in the order of `rays`.
+///
+/// Each ray leaves the hit point, pushed off the surface along the geometric normal (turned to face
+/// the incoming ray) by [`scene_epsilon`], in a cosine-weighted direction around that normal
+/// (unit length), over `t` in `[0, AO_RADIUS * diagonal]`. The random stream of each primary ray
+/// is keyed by its index, so its rays do not change when other rays start hitting or missing.
+pub fn ambient_occlusion(rays: &[Ray], hits: &[Hit], scene: &Scene, per_hit: usize, seed: u64) -> Vec<Ray> {
+    let bounds = scene.bounds();
+    let eps = scene_epsilon(bounds);
+    let radius = (AO_RADIUS * bounds.extent().length()).max(eps * 4.0);
+    let mut out = Vec::with_capacity(hits.iter().filter(|h| h.is_hit()).count() * per_hit);
+    for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+        let Some(p) = hit_point(ray, hit) else { continue };
+        let Some(t) = scene.triangles().get(hit.prim as usize) else { continue };
+        let mut n = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).normalize_or_zero();
+        if n == Vec3::ZERO {
+            continue;
+        }
+        if n.dot(ray.dir()) > 0.0 {
+            n = -n;
+        }
+        let mut rng = Pcg32::new(seed, i as u64);
+        for _ in 0..per_hit {
+            out.push(Ray::new(p + n * eps, cosine_direction(n, rng.in_unit_disk()), 0.0, radius));
+        }
+    }
+    out
+}
+
+/// The hit point of a closest hit (evaluated in `f64`, rounded once), or `None` for a miss or a
+/// non-finite point.
+fn hit_point(ray: &Ray, hit: &Hit) -> Option<Vec3> {
+    if !hit.is_hit() || !hit.t.is_finite() {
+        return None;
+    }
+    let p = (ray.origin().as_dvec3() + ray.dir().as_dvec3() * f64::from(hit.t)).as_vec3();
+    p.is_finite().then_some(p)
+}
+
+/// A unit direction around the unit normal `n` with density proportional to the cosine, from a
+/// uniform point `(x, y)` of the unit disk lifted onto the hemisphere (Malley's method).
+fn cosine_direction(n: Vec3, (x, y): (f32, f32)) -> Vec3 {
+    let (t, b) = n.any_orthonormal_pair();
+    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+    (t * x + b * y + n * z).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use raytrail::core::geometry::Triangle;
+
+    /// A unit square at z = 0 made of two triangles, seen from above.
+    fn floor() -> Scene {
+        let (a, b, c, d) = (Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y);
+        Scene::new(vec![Triangle::new(a, b, c), Triangle::new(a, c, d)]).unwrap()
+    }
+
+    #[test]
+    fn ao_rays_leave_the_surface_into_the_hemisphere() {
+        let scene = floor();
+        let rays: Vec<Ray> = (0..50)
+            .map(|i| Ray::new(Vec3::new(0.01 + i as f32 * 0.019, 0.3, 2.0), Vec3::NEG_Z, 0.0, f32::INFINITY))
+            .collect();
+        let mut hits: Vec<Hit> = rays.iter().map(|_| Hit { t: 2.0, prim: 0, u: 0.1, v: 0.1 }).collect();
+        hits[7] = Hit::MISS;
+        let ao = ambient_occlusion(&rays, &hits, &scene, 4, 1);
+        assert_eq!(ao.len(), 49 * 4);
+        let diagonal = scene.bounds().extent().length();
+        let mut mean_cos = 0.0;
+        for r in &ao {
+            let d = r.dir();
+            assert!((d.length() - 1.0).abs() < 1e-5);
+            // The triangle's normal is +z (counter-clockwise from above) and faces the ray already.
+            assert!(d.z >= 0.0, "{d}");
+            assert!(r.origin[2] > 0.0 && r.tmin == 0.0);
+            assert!((r.tmax - AO_RADIUS * diagonal).abs() < 1e-6);
+            mean_cos += d.z / ao.len() as f32;
+        }
+        // Cosine-weighted: E[cos] = 2/3 (uniform would give 1/2).
+        assert!((mean_cos - 2.0 / 3.0).abs() < 0.05, "{mean_cos}");
+        // Seen from below, the normal flips.
+        let below = [Ray::new(Vec3::new(0.5, 0.3, -2.0), Vec3::Z, 0.0, f32::INFINITY)];
+        let ao = ambient_occlusion(&below, &[Hit { t: 2.0, prim: 1, u: 0.2, v: 0.2 }], &scene, 8, 1);
+        assert!(ao.iter().all(|r| r.dir[2] <= 0.0 && r.origin[2] < 0.0));
+    }
+
+    #[test]
+    fn kinds_round_trip_and_query() {
+        for k in RayKind::ALL {
+            assert_eq!(RayKind::from_name(k.name()), Some(k));
+        }
+        assert_eq!(RayKind::Ao.query(), Query::Any);
+        assert_eq!(RayKind::Diffuse.query(), Query::Closest);
+    }
+}

@@ -1,0 +1,141 @@
+//! Bench targets: anything that traces a batch of rays into hits. raytrail's methods on a backend
+//! are targets, and so is each peer library; a new backend (wgpu) adds its own target type.
+
+use raytrail::core::observe::Counters;
+use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
+use raytrail::core::traverse::{Family, Method, Query};
+use raytrail::core::{Hit, Ray};
+use raytrail::cpu::{CpuBackend, CpuScene};
+
+/// What a target is, for grouping and colouring.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TargetKind {
+    /// A raytrail method over the BVH2.
+    RaytrailBvh2,
+    /// A raytrail method over the kd-tree.
+    RaytrailKd,
+    /// A raytrail method on the GPU (wgpu backend).
+    RaytrailGpu,
+    /// A peer library with its own triangle test.
+    PeerOwnTest,
+    /// A peer library's traversal with raytrail's watertight triangle test in its callback.
+    PeerWatertight,
+}
+
+impl TargetKind {
+    /// Name in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            TargetKind::RaytrailBvh2 => "raytrail-bvh2",
+            TargetKind::RaytrailKd => "raytrail-kd",
+            TargetKind::RaytrailGpu => "raytrail-gpu",
+            TargetKind::PeerOwnTest => "peer",
+            TargetKind::PeerWatertight => "peer-watertight",
+        }
+    }
+
+    /// Whether the target is one of raytrail's CPU methods (what the speed target compares).
+    pub fn is_raytrail(self) -> bool {
+        matches!(self, TargetKind::RaytrailBvh2 | TargetKind::RaytrailKd)
+    }
+
+    /// Whether the target is a peer library.
+    pub fn is_peer(self) -> bool {
+        matches!(self, TargetKind::PeerOwnTest | TargetKind::PeerWatertight)
+    }
+}
+
+/// Work per ray, where a target can count it (in a separate, untimed pass).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Work {
+    /// Nodes visited (internal and leaves) per ray.
+    pub nodes: Option<f64>,
+    /// Leaves visited per ray.
+    pub leaves: Option<f64>,
+    /// Ray/triangle tests per ray.
+    pub tests: Option<f64>,
+}
+
+/// Something the bench can time: traces rays into hits on a given thread pool.
+pub trait BenchTarget: Send + Sync {
+    /// Name in tables, JSON and plots; `--baseline` matches it.
+    fn name(&self) -> &str;
+    /// Group of the target.
+    fn kind(&self) -> TargetKind;
+    /// Traces `rays` into `hits` (same length) with `query`, parallel over `pool`'s threads.
+    fn trace(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<(), String>;
+    /// Traces as [`BenchTarget::trace`]; returns the seconds the target timed itself (GPU
+    /// timestamps), or `None` to be timed by the wall clock around the call.
+    fn trace_timed(
+        &self,
+        pool: &rayon::ThreadPool,
+        rays: &[Ray],
+        query: Query,
+        hits: &mut [Hit],
+    ) -> Result<Option<f64>, String> {
+        self.trace(pool, rays, query, hits).map(|_| None)
+    }
+    /// Counts the work per ray in an extra pass; `None` where the target cannot count.
+    fn work(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String>;
+}
+
+/// The targets of a run, in report order.
+pub type Targets = Vec<Box<dyn BenchTarget>>;
+
+/// A raytrail method on the CPU backend.
+///
+/// The backend is built without a pool of its own ([`CpuBackend::new`]) and called inside the
+/// bench's pool, so raytrail and the peers share one rayon pool per thread count: the same
+/// threads, the same scheduler.
+pub struct RaytrailCpu {
+    method: Method,
+    backend: CpuBackend,
+    scene: CpuScene,
+}
+
+impl RaytrailCpu {
+    /// The target tracing `method` over `scene`.
+    pub fn new(method: Method, scene: CpuScene) -> Self {
+        Self { method, backend: CpuBackend::new(), scene }
+    }
+
+    /// Traces with `record`, returning the counters when recorded.
+    fn run(
+        &self,
+        pool: &rayon::ThreadPool,
+        rays: &[Ray],
+        query: Query,
+        hits: &mut [Hit],
+        record: Record,
+    ) -> Result<Option<Counters>, String> {
+        let opts = TraceOptions { method: self.method, query, triangle_test: TriangleTestKind::Watertight, record };
+        let report = pool
+            .install(|| self.backend.trace(&self.scene, rays, &opts, hits))
+            .map_err(|e| format!("{}: {e}", self.method))?;
+        Ok(report.counters)
+    }
+}
+
+impl BenchTarget for RaytrailCpu {
+    fn name(&self) -> &str {
+        self.method.name()
+    }
+
+    fn kind(&self) -> TargetKind {
+        match self.method.family() {
+            Family::Bvh2 => TargetKind::RaytrailBvh2,
+            Family::Kd => TargetKind::RaytrailKd,
+        }
+    }
+
+    fn trace(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<(), String> {
+        self.run(pool, rays, query, hits, Record::Nothing).map(|_| ())
+    }
+
+    fn work(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String> {
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let Some(c) = self.run(pool, rays, query, &mut hits, Record::Counters)? else { return Ok(None) };
+        let per_ray = |x: u64| Some(x as f64 / c.rays.max(1) as f64);
+        Ok(Some(Work { nodes: per_ray(c.nodes()), leaves: per_ray(c.leaves), tests: per_ray(c.primitive_tests) }))
+    }
+}

@@ -1,0 +1,66 @@
+//! raytrail's methods on the GPU as bench targets (the wgpu backend).
+
+use super::target::{BenchTarget, TargetKind, Work};
+use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
+use raytrail::core::traverse::{Method, Query};
+use raytrail::core::{Hit, Ray};
+use raytrail::gpu::{WgpuBackend, WgpuScene};
+use std::sync::Arc;
+
+/// One method on the GPU. The thread pool does not apply: the GPU traces the whole batch.
+pub struct RaytrailGpu {
+    method: Method,
+    name: String,
+    backend: Arc<WgpuBackend>,
+    scene: Arc<WgpuScene>,
+}
+
+impl RaytrailGpu {
+    /// The target tracing `method` over `scene` on `backend`.
+    pub fn new(method: Method, backend: Arc<WgpuBackend>, scene: Arc<WgpuScene>) -> Self {
+        Self { method, name: format!("gpu:{}", method.name()), backend, scene }
+    }
+
+    fn run(
+        &self,
+        rays: &[Ray],
+        query: Query,
+        hits: &mut [Hit],
+        record: Record,
+    ) -> Result<raytrail::core::trace::Report, String> {
+        let opts = TraceOptions { method: self.method, query, triangle_test: TriangleTestKind::Watertight, record };
+        self.backend.trace(&self.scene, rays, &opts, hits).map_err(|e| format!("{}: {e}", self.name))
+    }
+}
+
+impl BenchTarget for RaytrailGpu {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn kind(&self) -> TargetKind {
+        TargetKind::RaytrailGpu
+    }
+
+    fn trace(&self, _pool: &rayon::ThreadPool, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<(), String> {
+        self.run(rays, query, hits, Record::Nothing).map(|_| ())
+    }
+
+    fn trace_timed(
+        &self,
+        _pool: &rayon::ThreadPool,
+        rays: &[Ray],
+        query: Query,
+        hits: &mut [Hit],
+    ) -> Result<Option<f64>, String> {
+        let report = self.run(rays, query, hits, Record::Nothing)?;
+        Ok(self.backend.has_gpu_timer().then_some(report.seconds))
+    }
+
+    fn work(&self, _pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String> {
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let Some(c) = self.run(rays, query, &mut hits, Record::Counters)?.counters else { return Ok(None) };
+        let per_ray = |x: u64| Some(x as f64 / c.rays.max(1) as f64);
+        Ok(Some(Work { nodes: per_ray(c.nodes()), leaves: per_ray(c.leaves), tests: per_ray(c.primitive_tests) }))
+    }
+}

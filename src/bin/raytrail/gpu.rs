@@ -1,0 +1,71 @@
+//! The main job's GPU part: the same rays and methods on the wgpu backend, timed, and checked
+//! against the CPU ray by ray.
+
+use raytrail::conformance::check::{compare, compare_backends, trace_all, Context, Mismatch};
+use raytrail::core::prepared::PreparedBvh2;
+use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
+use raytrail::core::traverse::{Method, Query};
+use raytrail::core::{Hit, Ray};
+use raytrail::cpu::{CpuBackend, CpuScene};
+use raytrail::gpu::{WgpuBackend, WgpuScene};
+use std::sync::Arc;
+
+/// The GPU side of a run, when there is an adapter.
+pub struct Gpu {
+    backend: WgpuBackend,
+    scene: WgpuScene,
+}
+
+impl Gpu {
+    /// Opens the adapter and uploads the scene, or says in one line why the GPU part is skipped.
+    pub fn open(prepared: Arc<PreparedBvh2>) -> Result<Gpu, String> {
+        let backend = WgpuBackend::new().map_err(|e| e.to_string())?;
+        let scene = backend.prepare(prepared).map_err(|e| e.to_string())?;
+        Ok(Gpu { backend, scene })
+    }
+
+    /// The adapter, the timer used, and what its compiler does to float arithmetic.
+    pub fn describe(&self) -> String {
+        let timer = if self.backend.has_gpu_timer() {
+            "GPU timestamps"
+        } else {
+            "wall clock, transfers included (no timestamp queries)"
+        };
+        let probe = match self.backend.probe_numerics(1 << 16) {
+            Ok(p) => p.summary(),
+            Err(e) => format!("numerics probe failed: {e}"),
+        };
+        format!("{}; timed by {timer}\n  numerics probe: {probe}", self.backend.adapter())
+    }
+
+    /// Median seconds of `passes` timed traces (after one untimed pass that compiles the kernel).
+    pub fn time(&self, rays: &[Ray], method: Method, query: Query, passes: usize) -> Result<f64, String> {
+        let opts = TraceOptions { method, query, triangle_test: TriangleTestKind::Watertight, record: Record::Nothing };
+        let mut hits = vec![Hit::MISS; rays.len()];
+        self.backend.trace(&self.scene, rays, &opts, &mut hits).map_err(|e| e.to_string())?;
+        let mut times = Vec::with_capacity(passes);
+        for _ in 0..passes {
+            times.push(self.backend.trace(&self.scene, rays, &opts, &mut hits).map_err(|e| e.to_string())?.seconds);
+        }
+        times.sort_by(f64::total_cmp);
+        Ok(times[times.len() / 2])
+    }
+
+    /// Every method on `rays` on the GPU: against its reference there, and against the CPU.
+    pub fn check(
+        &self,
+        cpu: &CpuBackend,
+        cpu_scene: &CpuScene,
+        ctx: Context<'_>,
+        rays: &[Ray],
+    ) -> Result<Vec<Mismatch>, String> {
+        let mut out = Vec::new();
+        for query in [Query::Closest, Query::Any] {
+            let on_cpu = trace_all(cpu, cpu_scene, rays, &Method::ALL, query).map_err(|e| e.to_string())?;
+            let on_gpu = trace_all(&self.backend, &self.scene, rays, &Method::ALL, query).map_err(|e| e.to_string())?;
+            out.extend(compare(ctx, rays, &on_gpu));
+            out.extend(compare_backends(ctx, rays, &on_cpu, &on_gpu));
+        }
+        Ok(out)
+    }
+}
