@@ -243,13 +243,39 @@ pub fn compare_backends(ctx: Context<'_>, rays: &[Ray], cpu: &[Outcome], other: 
                 );
             }
         }
-        for (i, (e, g)) in c.enumerations.iter().zip(&o.enumerations).enumerate() {
-            if e != g {
-                push(i, Difference::Enumeration { expected: e.clone(), got: g.clone() });
+        // Indexed by the reference's enumerations, so a backend that recorded none (or too few)
+        // mismatches instead of being compared over nothing.
+        for (i, e) in c.enumerations.iter().enumerate() {
+            let g = o.enumerations.get(i).map_or(&[][..], Vec::as_slice);
+            if e.as_slice() != g {
+                push(i, Difference::Enumeration { expected: e.clone(), got: g.to_vec() });
             }
         }
     }
     out
+}
+
+/// Runs every method in `methods` for both queries on `rays`, on `backend` and on `reference`
+/// (the CPU): on `backend`, every method against its own reference ([`compare`]), and every
+/// outcome against the reference backend's, ray by ray ([`compare_backends`]).
+#[allow(clippy::too_many_arguments)]
+pub fn check_against<R: Trace, B: Trace>(
+    reference: &R,
+    reference_scene: &R::Prepared,
+    backend: &B,
+    scene: &B::Prepared,
+    ctx: Context<'_>,
+    rays: &[Ray],
+    methods: &[Method],
+) -> Result<Vec<Mismatch>, Error> {
+    let mut all = Vec::new();
+    for query in [Query::Closest, Query::Any] {
+        let expected = trace_all(reference, reference_scene, rays, methods, query)?;
+        let got = trace_all(backend, scene, rays, methods, query)?;
+        all.extend(compare(ctx, rays, &got));
+        all.extend(compare_backends(ctx, rays, &expected, &got));
+    }
+    Ok(all)
 }
 
 /// Runs every method for both queries on one ray set and compares; the mismatches found.
@@ -271,6 +297,21 @@ pub fn check_ray_set<B: Trace>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_backend_that_recorded_no_enumerations_mismatches() {
+        let rays = [Ray::new(glam::Vec3::ZERO, glam::Vec3::X, 0.0, 1.0)];
+        let outcome = |enumerations: Vec<Vec<u32>>| Outcome {
+            method: Method::Hash,
+            query: Query::Closest,
+            hits: vec![Hit::MISS],
+            enumerations,
+        };
+        let ctx = Context { scene: "s", ray_set: "r", backend: "b" };
+        let found = compare_backends(ctx, &rays, &[outcome(vec![vec![1, 2]])], &[outcome(Vec::new())]);
+        assert_eq!(found.len(), 1);
+        assert_eq!(found[0].difference, Difference::Enumeration { expected: vec![1, 2], got: Vec::new() });
+    }
 
     #[test]
     fn parting_points() {

@@ -1,8 +1,8 @@
 //! The wgpu half of the suite: one device for the whole test binary, and the check that the GPU
 //! agrees with itself across methods and with the CPU ray by ray.
 
-use super::{mismatch_report, ALL_QUERIES};
-use raytrail_conformance::check::{compare, compare_backends, trace_all, Context, Mismatch};
+use super::mismatch_report;
+use raytrail_conformance::check::{check_against, Context, Mismatch};
 use raytrail_conformance::rays::{ray_sets, RaySetSize};
 use raytrail_conformance::NamedScene;
 use raytrail_core::bvh2::Bvh2;
@@ -71,15 +71,8 @@ pub fn check_scene_gpu(named: &NamedScene, bvh: Bvh2, size: RaySetSize) {
     let mut checked = 0;
     for set in &sets {
         let ctx = Context { scene: &named.name, ray_set: set.kind.name(), backend: "wgpu" };
-        for query in ALL_QUERIES {
-            let on_cpu = trace_all(&cpu, &cpu_scene, &set.rays, &Method::ALL, query).expect("trace on the CPU");
-            let on_gpu = trace_all(gpu, &gpu_scene, &set.rays, &Method::ALL, query).expect("trace on the GPU");
-            for o in &on_gpu {
-                assert_eq!(o.enumerations.len(), set.rays.len(), "wgpu {} recorded no enumerations", o.method);
-            }
-            mismatches.extend(compare(ctx, &set.rays, &on_gpu));
-            mismatches.extend(compare_backends(ctx, &set.rays, &on_cpu, &on_gpu));
-        }
+        mismatches
+            .extend(check_against(&cpu, &cpu_scene, gpu, &gpu_scene, ctx, &set.rays, &Method::ALL).expect("trace"));
         checked += set.rays.len();
     }
     assert!(checked > 0, "{}: no rays were checked", named.name);

@@ -11,7 +11,6 @@ use raytrail_core::bvh2::Bvh2;
 use raytrail_core::prepared::PreparedBvh2;
 use raytrail_core::trace::{Trace, TraceOptions};
 use raytrail_core::traverse::Method;
-use raytrail_core::traverse::Query;
 use raytrail_core::Hit;
 use raytrail_cpu::CpuBackend;
 use std::sync::Arc;
@@ -19,9 +18,6 @@ use std::sync::Arc;
 pub mod gpu;
 #[macro_use]
 mod suite;
-
-/// Both queries, in the order the suite checks them.
-pub const ALL_QUERIES: [Query; 2] = [Query::Closest, Query::Any];
 
 /// Set to 1 to let the mesh tests pass without `../shared/scenes` (they then print why).
 pub const ALLOW_MISSING: &str = "RAYTRAIL_ALLOW_MISSING_SCENES";

@@ -1,7 +1,7 @@
 //! The main job's GPU part: the same rays and methods on the wgpu backend, timed, and checked
 //! against the CPU ray by ray.
 
-use raytrail::conformance::check::{compare, compare_backends, trace_all, Context, Mismatch};
+use raytrail::conformance::check::{check_against, Context, Mismatch};
 use raytrail::core::prepared::PreparedBvh2;
 use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
 use raytrail::core::traverse::{Method, Query};
@@ -47,8 +47,7 @@ impl Gpu {
         for _ in 0..passes {
             times.push(self.backend.trace(&self.scene, rays, &opts, &mut hits).map_err(|e| e.to_string())?.seconds);
         }
-        times.sort_by(f64::total_cmp);
-        Ok(times[times.len() / 2])
+        Ok(crate::run::median(&mut times))
     }
 
     /// Every method on `rays` on the GPU: against its reference there, and against the CPU.
@@ -59,13 +58,6 @@ impl Gpu {
         ctx: Context<'_>,
         rays: &[Ray],
     ) -> Result<Vec<Mismatch>, String> {
-        let mut out = Vec::new();
-        for query in [Query::Closest, Query::Any] {
-            let on_cpu = trace_all(cpu, cpu_scene, rays, &Method::ALL, query).map_err(|e| e.to_string())?;
-            let on_gpu = trace_all(&self.backend, &self.scene, rays, &Method::ALL, query).map_err(|e| e.to_string())?;
-            out.extend(compare(ctx, rays, &on_gpu));
-            out.extend(compare_backends(ctx, rays, &on_cpu, &on_gpu));
-        }
-        Ok(out)
+        check_against(cpu, cpu_scene, &self.backend, &self.scene, ctx, rays, &Method::ALL).map_err(|e| e.to_string())
     }
 }
