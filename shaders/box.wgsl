@@ -26,9 +26,10 @@ fn is_traceable(r: Ray) -> bool {
 fn ctx_init(r: Ray) -> bool {
     let reach = P.scene_scale + max_element(abs(r.origin));
     let d = max_element(abs(r.dir));
+    let reach_per_d = div_rn(reach, d);
     var slack = bitcast<f32>(0x7f800000u);
-    if reach * reach * div_rn(reach, d) < bitcast<f32>(RELIABLE_LIMIT_BITS) {
-        slack = div_rn(bitcast<f32>(SLACK_SCALE_BITS) * reach, d);
+    if reach * reach * reach_per_d < bitcast<f32>(RELIABLE_LIMIT_BITS) {
+        slack = reach_per_d * bitcast<f32>(SLACK_SCALE_BITS);
     }
     C.origin = r.origin;
     C.tmin = r.tmin;

@@ -6,7 +6,7 @@
 //! - by override constants, for switches the compiler folds away: any hit, recording, the
 //!   disjoint-interval mask.
 
-use raytrail_core::intersect::{FAR_PAD, RELIABLE_LIMIT, SLACK_ULPS};
+use raytrail_core::intersect::{FAR_PAD, RELIABLE_LIMIT, SLACK_SCALE};
 use raytrail_core::kd::traverse::{PACKET_WIDTH, SHORT_STACK_MAX};
 use raytrail_core::key::KeyWidth;
 use raytrail_core::trace::{Record, TriangleTestKind};
@@ -146,7 +146,7 @@ fn constants_header(method: Method) -> String {
          const SHORT_STACK_MAX: u32 = {SHORT_STACK_MAX}u;\n\
          const PACKET_WIDTH: u32 = {PACKET_WIDTH}u;\n",
         FAR_PAD.to_bits(),
-        (SLACK_ULPS * f32::EPSILON).to_bits(),
+        SLACK_SCALE.to_bits(),
         RELIABLE_LIMIT.to_bits(),
     )
 }
@@ -208,6 +208,7 @@ mod tests {
     fn constants_are_the_cores_bits() {
         let h = constants_header(Method::Stack);
         assert!(h.contains(&format!("{:#010x}", FAR_PAD.to_bits())));
-        assert_eq!((SLACK_ULPS * f32::EPSILON).to_bits(), (1.0f32 / 131072.0).to_bits());
+        assert!(h.contains(&format!("{:#010x}", SLACK_SCALE.to_bits())));
+        assert_eq!(SLACK_SCALE.to_bits(), (1.0f32 / 524288.0).to_bits());
     }
 }

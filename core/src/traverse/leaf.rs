@@ -17,6 +17,7 @@ pub fn intersect_leaf<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
 ) -> ([NodeRef; 3], bool) {
     let mut o = offset;
     let mut accepted = false;
+    let per_ray = ctx.tri();
     loop {
         let w0 = mem.read_leaf_word(o);
         if w0.is_terminator() {
@@ -26,7 +27,7 @@ pub fn intersect_leaf<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
         obs.primitive(prim);
         let (w1, w2) = (mem.read_leaf_word(o + 1), mem.read_leaf_word(o + 2));
         let vertices = [w0.vertex_ref(), w1.vertex_ref(), w2.vertex_ref()];
-        if let Some(h) = T::intersect_in_place(&ctx.tri, vertices, ctx.ray.tmin, q.limit()) {
+        if let Some(h) = T::intersect_in_place(&per_ray, vertices, ctx.ray.tmin, q.limit()) {
             if q.offer(h, prim) {
                 obs.hit(prim, h.t);
                 accepted = true;

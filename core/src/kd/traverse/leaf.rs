@@ -22,12 +22,13 @@ pub fn kd_leaf<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
     obs: &mut O,
 ) -> bool {
     obs.node(NodeRef::leaf(index));
+    let per_ray = ctx.tri();
     for i in node.first()..node.first() + node.count() {
         let prim = mem.prim_ref(i);
         obs.primitive(prim);
         let tri = mem.read_triangle(prim);
         let [a, b, c] = &*tri;
-        if let Some(h) = T::intersect_in_place(&ctx.tri, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit())
+        if let Some(h) = T::intersect_in_place(&per_ray, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit())
         {
             if q.offer(h, prim) {
                 obs.hit(prim, h.t);

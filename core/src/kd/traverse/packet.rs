@@ -40,7 +40,7 @@ pub fn trace_kd_packet<const W: usize, M: KdMemory + ?Sized, T: TriangleTest, O:
 ) {
     let n = rays.len().min(W).min(hits.len()).min(obs.len());
     let capacity = capacity.min(SHORT_STACK_MAX);
-    let mut ctx: [Option<RayContext<T>>; W] = [None; W];
+    let mut ctx: [Option<RayContext<T>>; W] = core::array::from_fn(|_| None);
     let mut q: [QueryState; W] = core::array::from_fn(|i| QueryState::new(&rays[i.min(n.saturating_sub(1))], any));
     let (mut t_min, mut t_max, mut scene_max) = ([0.0f32; W], [0.0f32; W], [0.0f32; W]);
     let mut done = [true; W];
