@@ -2,7 +2,7 @@
 
 use crate::batch::{self, SceneBindings};
 use crate::compose::Variant;
-use crate::device::{device_error, Gpu};
+use crate::device::{device_error, Gpu, KernelForm};
 use crate::packets::packet_order;
 use crate::params::Params;
 use crate::pipelines::Pipelines;
@@ -37,9 +37,15 @@ pub struct WgpuBackend {
 }
 
 impl WgpuBackend {
-    /// Opens the first adapter wgpu finds; fails with [`Error::Device`] naming why there is none.
+    /// Opens the first adapter wgpu finds, with the kernel form [`KERNEL_FORM`](crate::KERNEL_FORM)
+    /// names (default: auto); fails with [`Error::Device`] naming why there is none.
     pub fn new() -> Result<WgpuBackend, Error> {
-        let gpu = Gpu::open()?;
+        Self::with_kernel_form(KernelForm::from_env()?)
+    }
+
+    /// Opens the first adapter wgpu finds, handing it kernels in `form`.
+    pub fn with_kernel_form(form: KernelForm) -> Result<WgpuBackend, Error> {
+        let gpu = Gpu::open(form)?;
         let pipelines = Pipelines::new(&gpu);
         Ok(WgpuBackend { gpu, pipelines })
     }

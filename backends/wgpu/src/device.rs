@@ -19,14 +19,53 @@ pub struct Gpu {
     pub(crate) limits: wgpu::Limits,
     /// Whether compute passes can be timed with timestamp queries.
     pub(crate) timestamps: bool,
+    /// Whether kernels are compiled to SPIR-V that asks the driver to keep subnormals (see
+    /// [`crate::spirv`]); otherwise they go to wgpu as WGSL and the driver's default applies.
+    pub(crate) preserve_subnormals: bool,
+    /// Why the kernels have the form they have, for reports.
+    pub(crate) form_reason: &'static str,
+}
+
+/// Environment variable choosing the [`KernelForm`] of [`crate::WgpuBackend::new`]: `auto` (the
+/// default), `wgsl` or `spirv`.
+pub const KERNEL_FORM: &str = "RAYTRAIL_WGPU_KERNELS";
+
+/// How the kernels are handed to the driver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum KernelForm {
+    /// WGSL where its kernels already keep subnormals; else SPIR-V with `DenormPreserve` where the
+    /// driver reports the mode or, not reporting it, is shown by the numerics probe to honour it
+    /// (NVIDIA's Vulkan driver 580 does); else WGSL, and the conformance suite reports the flushes.
+    #[default]
+    Auto,
+    /// WGSL through wgpu: the driver's default subnormal mode applies (to compare speed, or to see
+    /// what that default does to conformance).
+    Wgsl,
+    /// SPIR-V with subnormals preserved wherever wgpu's passthrough is available, even where the
+    /// driver does not report the mode (to test that path on drivers that keep subnormals anyway).
+    Spirv,
+}
+
+impl KernelForm {
+    /// The form named by [`KERNEL_FORM`] (`Auto` when unset); an unknown name is an error.
+    pub fn from_env() -> Result<KernelForm, Error> {
+        match std::env::var(KERNEL_FORM).as_deref() {
+            Err(_) | Ok("") | Ok("auto") => Ok(KernelForm::Auto),
+            Ok("wgsl") => Ok(KernelForm::Wgsl),
+            Ok("spirv") => Ok(KernelForm::Spirv),
+            Ok(other) => Err(device_error(format!("{KERNEL_FORM}={other}: expected auto, wgsl or spirv"))),
+        }
+    }
 }
 
 impl Gpu {
     /// Opens the first adapter wgpu finds (high-performance preference), with 64-bit floats (the
-    /// watertight test's exact fallback) and, where supported, timestamp queries.
+    /// watertight test's exact fallback), where supported timestamp queries, and kernels in `form`
+    /// (for `Auto`, settled by the numerics probe where the driver does not report float controls).
     ///
-    /// Fails with [`Error::Device`] naming the reason when there is no adapter or it lacks f64.
-    pub fn open() -> Result<Gpu, Error> {
+    /// Fails with [`Error::Device`] naming the reason when there is no adapter, it lacks f64, or it
+    /// cannot take the form asked for.
+    pub fn open(form: KernelForm) -> Result<Gpu, Error> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
         let options = wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
@@ -50,6 +89,26 @@ impl Gpu {
         if timestamps {
             features |= wgpu::Features::TIMESTAMP_QUERY;
         }
+        let passthrough = available.contains(wgpu::Features::PASSTHROUGH_SHADERS);
+        let driver_denorm_preserve = crate::float_controls::driver_can_preserve_subnormals(&adapter);
+        let (preserve_subnormals, form_reason) = match form {
+            KernelForm::Auto if passthrough && driver_denorm_preserve == Some(true) => {
+                (true, "the driver reports DenormPreserve for f32")
+            }
+            // Settled by the probe once the device is open.
+            KernelForm::Auto => (false, "no shader passthrough"),
+            KernelForm::Wgsl => (false, "asked for"),
+            KernelForm::Spirv if passthrough => (true, "asked for"),
+            KernelForm::Spirv => {
+                return Err(device_error(format!(
+                    "adapter '{}' cannot take SPIR-V kernels (no shader passthrough)",
+                    info.name
+                )))
+            }
+        };
+        if passthrough && form != KernelForm::Wgsl {
+            features |= wgpu::Features::PASSTHROUGH_SHADERS;
+        }
         let limits = adapter.limits();
         let desc = wgpu::DeviceDescriptor {
             label: Some("raytrail"),
@@ -62,12 +121,28 @@ impl Gpu {
         // Errors are caught with error scopes where they can happen; anything else is logged
         // rather than aborting the process (wgpu's default handler panics).
         device.on_uncaptured_error(Arc::new(|e: wgpu::Error| eprintln!("raytrail-wgpu: uncaptured device error: {e}")));
-        Ok(Gpu { device, queue, info, limits, timestamps })
+        let mut gpu = Gpu { device, queue, info, limits, timestamps, preserve_subnormals, form_reason };
+        if form == KernelForm::Auto && passthrough && driver_denorm_preserve != Some(true) {
+            gpu.settle_kernel_form()?;
+        }
+        Ok(gpu)
     }
 
     /// The adapter's name, driver and API, for reports.
     pub fn describe(&self) -> String {
-        format!("{} ({}, {:?})", self.info.name, self.info.driver_info, self.info.backend)
+        format!(
+            "{} ({}, {:?}; kernels as {})",
+            self.info.name,
+            self.info.driver_info,
+            self.info.backend,
+            self.kernel_form()
+        )
+    }
+
+    /// How the kernels reach the driver, and why.
+    pub fn kernel_form(&self) -> String {
+        let form = if self.preserve_subnormals { "SPIR-V with DenormPreserve" } else { "WGSL" };
+        format!("{form}: {}", self.form_reason)
     }
 
     /// Runs `f`, turning any validation or out-of-memory error it raises into [`Error::Device`].

@@ -15,14 +15,18 @@ mod backend;
 mod batch;
 pub mod compose;
 mod device;
+mod float_controls;
+mod kernel;
 mod packets;
 mod params;
 mod pipelines;
 mod probe;
 mod record;
 mod scene;
+mod spirv;
 
 pub use backend::WgpuBackend;
+pub use device::{KernelForm, KERNEL_FORM};
 pub use probe::NumericsProbe;
 pub use scene::WgpuScene;
 

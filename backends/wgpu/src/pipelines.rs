@@ -13,7 +13,7 @@ pub(crate) struct Pipelines {
     compiled: Mutex<HashMap<Variant, Arc<wgpu::ComputePipeline>>>,
 }
 
-fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
@@ -52,25 +52,7 @@ impl Pipelines {
             return Ok(p.clone());
         }
         let label = v.label();
-        let source = v.source();
-        let overrides = v.overrides();
-        let pipeline = gpu.checked(&format!("compiling kernel {label}"), || {
-            let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(&label),
-                source: wgpu::ShaderSource::Wgsl(source.into()),
-            });
-            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(&label),
-                layout: Some(&self.layout),
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &overrides,
-                    zero_initialize_workgroup_memory: false,
-                },
-                cache: None,
-            })
-        })?;
+        let pipeline = gpu.compute_pipeline(&label, &v.source(), &v.overrides(), &self.layout)?;
         let pipeline = Arc::new(pipeline);
         self.compiled.lock().map_err(|_| poisoned())?.insert(*v, pipeline.clone());
         Ok(pipeline)

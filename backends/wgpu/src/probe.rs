@@ -4,6 +4,7 @@
 //! matches the CPU bit for bit. NUMERICS.md explains what the kernels do about each.
 
 use crate::device::{device_error, Gpu};
+use crate::pipelines::entry;
 use raytrail_core::Error;
 use wgpu::util::DeviceExt;
 
@@ -83,18 +84,20 @@ pub(crate) fn probe(gpu: &Gpu, n: usize) -> Result<NumericsProbe, Error> {
     let input = samples(n);
     let d = &gpu.device;
     let out: Vec<[u32; 4]> = gpu.checked("running the numerics probe", || -> Result<Vec<[u32; 4]>, Error> {
-        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        let read = wgpu::BufferBindingType::Storage { read_only: true };
+        let write = wgpu::BufferBindingType::Storage { read_only: false };
+        let entries = [entry(0, wgpu::BufferBindingType::Uniform), entry(1, read), entry(2, write)];
+        let bind_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("numerics probe"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
+            entries: &entries,
         });
-        let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("numerics probe"),
-            layout: None,
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
+            bind_group_layouts: &[Some(&bind_layout)],
+            immediate_size: 0,
         });
+        // Compiled as the kernels are, so it measures what they get.
+        let pipeline = gpu.compute_pipeline("numerics probe", &source, &[], &layout)?;
         let bytes = (input.len() * 16) as u64;
         let zero = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("zero"),
@@ -120,7 +123,7 @@ pub(crate) fn probe(gpu: &Gpu, n: usize) -> Result<NumericsProbe, Error> {
         });
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("numerics probe"),
-            layout: &pipeline.get_bind_group_layout(0),
+            layout: &bind_layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: zero.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: src.as_entire_binding() },

@@ -38,6 +38,11 @@ SCENES:  OBJ, PLY (ASCII or binary), optionally gzip-compressed; `builtin` is a 
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    // `--help` anywhere (`raytrail bench --help`) prints the usage rather than a parse error.
+    if args.iter().any(|a| a == "-h" || a == "--help") {
+        println!("{USAGE}");
+        return;
+    }
     let (cmd, rest) = match args.first().map(String::as_str) {
         None => ("run", &args[..]),
         Some("-h" | "--help" | "help") => {

@@ -5,8 +5,12 @@
 //! round-robin: pass 1 of every target, then pass 2 of every target, and so on, so that a slow
 //! spell of the shared machine spreads over all targets instead of hitting one. A target's speed
 //! is the median of its passes, timed by the wall clock around its trace call (GPU targets with
-//! timestamp queries time themselves). Work per ray is
-//! counted in one more untimed pass, on the largest pool.
+//! timestamp queries time themselves). A GPU pass takes about a millisecond, and between them the
+//! CPU passes take seconds in which the GPU drops to idle clocks: interleaved, the same kernel
+//! measured up to 5x slower from one row to the next on an H100. So a GPU target's passes run back
+//! to back after [`CLOCK_SPIN`] of untimed tracing (which narrows the spread but does not remove
+//! it: BENCHMARKS.md, the H100 section). Work per ray is counted in one more untimed pass, on the
+//! largest pool.
 
 use super::agreement::{compare, Agreement};
 use super::rays::RayBatch;
@@ -15,7 +19,11 @@ use super::target::BenchTarget;
 use crate::progress::Progress;
 use raytrail::core::geometry::Triangle;
 use raytrail::core::Hit;
-use std::time::Instant;
+use std::time::{Duration, Instant};
+
+/// Untimed tracing before the timed passes of a target that asks for it (GPUs), so that they run
+/// at the clocks a sustained load gets.
+const CLOCK_SPIN: Duration = Duration::from_millis(250);
 
 /// The fixed inputs of one scene's measurements.
 pub struct Plan<'a> {
@@ -54,10 +62,24 @@ impl Plan<'_> {
             let mut times = vec![Vec::with_capacity(self.passes); self.targets.len()];
             for pass in 0..self.passes {
                 for (t, secs) in self.targets.iter().zip(&mut times) {
-                    let start = Instant::now();
-                    let own = t.trace_timed(pool, rays, query, &mut hits)?;
-                    secs.push(own.unwrap_or_else(|| start.elapsed().as_secs_f64()));
-                    progress.step(&format!("{kind} {} pass {}, {threads} thr", t.name(), pass + 1));
+                    // A GPU gets its passes back to back, after the spin, in the first round.
+                    let (spin, count) = match (t.needs_clock_spin(), pass) {
+                        (false, _) => (false, 1),
+                        (true, 0) => (true, self.passes),
+                        (true, _) => continue,
+                    };
+                    if spin {
+                        let spin = Instant::now();
+                        while spin.elapsed() < CLOCK_SPIN {
+                            t.trace(pool, rays, query, &mut hits)?;
+                        }
+                    }
+                    for k in 0..count {
+                        let start = Instant::now();
+                        let own = t.trace_timed(pool, rays, query, &mut hits)?;
+                        secs.push(own.unwrap_or_else(|| start.elapsed().as_secs_f64()));
+                        progress.step(&format!("{kind} {} pass {}, {threads} thr", t.name(), pass + k + 1));
+                    }
                 }
             }
             for (t, passes) in self.targets.iter().zip(times) {

@@ -146,6 +146,12 @@ impl Options {
         if threads.is_empty() {
             return Err("--threads: no thread count given".to_string());
         }
+        // Without peers, the default baseline is the first method run.
+        let baseline = match (a.get("baseline"), methods.first()) {
+            (Some(b), _) => b.to_string(),
+            (None, Some(first)) if peers.is_empty() => first.name().to_string(),
+            (None, _) => "obvhs-bvh2".to_string(),
+        };
         Ok(Options {
             scenes,
             rays,
@@ -155,7 +161,7 @@ impl Options {
             threads,
             methods,
             peers,
-            baseline: a.get("baseline").unwrap_or("obvhs-bvh2").to_string(),
+            baseline,
             json: a.get("json").map(str::to_string),
             plot: a.get("plot").map(str::to_string),
             builder: Builder::from_name(a.get("builder").unwrap_or("sah"))?,
@@ -204,6 +210,13 @@ mod tests {
         assert_eq!(o.rays, vec![RayKind::Ao, RayKind::Primary]);
         assert_eq!(o.threads, vec![1, 2]);
         assert_eq!(o.methods, vec![Method::Hash, Method::Stack]);
+        assert_eq!(o.baseline, "obvhs-bvh2", "peers run by default: the baseline is obvhs-bvh2");
+        assert_eq!(
+            parse("--peers none --methods uncle,stack").unwrap().baseline,
+            "uncle",
+            "no peers: the first method"
+        );
+        assert_eq!(parse("--peers none --baseline stack").unwrap().baseline, "stack");
     }
 
     #[test]

@@ -75,6 +75,11 @@ pub trait BenchTarget: Send + Sync {
     ) -> Result<Option<f64>, String> {
         self.trace(pool, rays, query, hits).map(|_| None)
     }
+    /// Whether each timed pass must follow a spell of untimed load (a GPU, whose clocks drop while
+    /// the CPU targets run).
+    fn needs_clock_spin(&self) -> bool {
+        false
+    }
     /// Counts the work per ray in an extra pass; `None` where the target cannot count.
     fn work(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String>;
 }

@@ -46,6 +46,10 @@ impl BenchTarget for RaytrailGpu {
         self.run(rays, query, hits, Record::Nothing).map(|_| ())
     }
 
+    fn needs_clock_spin(&self) -> bool {
+        true
+    }
+
     fn trace_timed(
         &self,
         _pool: &rayon::ThreadPool,
