@@ -25,8 +25,10 @@ fn is_traceable(r: Ray) -> bool {
 // `RayContext::new` for the slab part; returns `is_reliable()`.
 fn ctx_init(r: Ray) -> bool {
     let reach = P.scene_scale + max_element(abs(r.origin));
-    let d = max_element(abs(r.dir));
-    let reach_per_d = div_rn(reach, d);
+    let inv_dir = div_rn3(vec3<f32>(1.0), r.dir);
+    // 1 / max|d| exactly, as on the CPU: the smallest |1 / d_i|.
+    let inv_abs = abs(inv_dir);
+    let reach_per_d = reach * min(min(inv_abs.x, inv_abs.y), inv_abs.z);
     var slack = bitcast<f32>(0x7f800000u);
     if reach * reach * reach_per_d < bitcast<f32>(RELIABLE_LIMIT_BITS) {
         slack = reach_per_d * bitcast<f32>(SLACK_SCALE_BITS);
@@ -34,7 +36,7 @@ fn ctx_init(r: Ray) -> bool {
     C.origin = r.origin;
     C.tmin = r.tmin;
     C.tmax = r.tmax;
-    C.inv_dir = div_rn3(vec3<f32>(1.0), r.dir);
+    C.inv_dir = inv_dir;
     C.negative = vec3<bool>(sign_bit(r.dir.x), sign_bit(r.dir.y), sign_bit(r.dir.z));
     C.t_slack = slack;
     return is_finite(slack);

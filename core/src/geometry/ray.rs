@@ -1,5 +1,5 @@
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 /// A ray with its parametric interval: points `origin + t * dir` for `t` in `[tmin, tmax]`.
 ///
@@ -43,13 +43,11 @@ impl Ray {
     /// node.
     #[inline]
     pub fn is_traceable(&self) -> bool {
-        let o = self.origin();
-        let d = self.dir();
-        o.is_finite()
-            && d.is_finite()
-            && d != Vec3::ZERO
-            && !self.tmin.is_nan()
-            && !self.tmax.is_nan()
-            && self.tmin <= self.tmax
+        let o = Vec3A::from_array(self.origin);
+        let d = Vec3A::from_array(self.dir);
+        // `x * 0` is ±0 for a finite `x` and NaN for an infinite or NaN one: one lane-wise test
+        // for all six components. `tmin <= tmax` is false when either bound is NaN.
+        let finite = (o * 0.0 + d * 0.0).cmpeq(Vec3A::ZERO).all();
+        finite && d.cmpne(Vec3A::ZERO).any() && self.tmin <= self.tmax
     }
 }

@@ -9,7 +9,7 @@ mod slab;
 mod slab_pair;
 mod watertight;
 
-pub use context::{RayContext, RELIABLE_LIMIT, SLACK_SCALE, SLACK_ULPS};
+pub use context::{BoxConstants, KdRayContext, NoPair, RayContext, RELIABLE_LIMIT, SLACK_SCALE, SLACK_ULPS};
 pub use moller_trumbore::MollerTrumbore;
 pub use slab::{BoxHit, SlabRay, FAR_PAD};
 pub use slab_pair::{hit_pair_scalar, SlabPair};

@@ -3,7 +3,7 @@ use super::{
     StackState, Step, UncleHops,
 };
 use crate::bvh2::{BvhMemory, NodeRef};
-use crate::intersect::{RayContext, TriangleTest};
+use crate::intersect::{BoxConstants, RayContext, SlabPair, TriangleTest};
 use crate::key::Key;
 use crate::observe::Observer;
 use crate::{Hit, Ray};
@@ -23,11 +23,15 @@ pub struct TraceRoot {
 /// The per-ray constants and an empty answer, or `None` for a ray every method treats as a miss
 /// (not traceable, or with distances that overflow: [`RayContext::is_reliable`]).
 #[inline(always)]
-pub fn begin<T: TriangleTest>(ray: &Ray, scene_scale: f32, query: Query) -> Option<(RayContext<T>, QueryState)> {
+pub fn begin<T: TriangleTest, B: BoxConstants>(
+    ray: &Ray,
+    scene_scale: f32,
+    query: Query,
+) -> Option<(RayContext<T, B>, QueryState)> {
     if !ray.is_traceable() {
         return None;
     }
-    let ctx = RayContext::<T>::new(ray, scene_scale);
+    let ctx = RayContext::<T, B>::new(ray, scene_scale);
     ctx.is_reliable().then(|| (ctx, QueryState::new(ray, query == Query::Any)))
 }
 
@@ -118,7 +122,7 @@ fn for_each_ray<T: TriangleTest>(
     mut trace: impl FnMut(&RayContext<T>, &mut QueryState),
 ) {
     for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
-        *hit = match begin::<T>(ray, root.scene_scale, query) {
+        *hit = match begin::<T, SlabPair>(ray, root.scene_scale, query) {
             Some((ctx, mut q)) => {
                 trace(&ctx, &mut q);
                 q.hit

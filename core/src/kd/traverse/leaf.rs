@@ -1,5 +1,5 @@
 use crate::bvh2::NodeRef;
-use crate::intersect::{RayContext, TriangleTest};
+use crate::intersect::{KdRayContext, TriangleTest};
 use crate::kd::{KdMemory, KdNode};
 use crate::observe::Observer;
 use crate::traverse::QueryState;
@@ -17,7 +17,7 @@ pub fn kd_leaf<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
     index: u32,
     node: &KdNode,
     t_max: f32,
-    ctx: &RayContext<T>,
+    ctx: &KdRayContext<T>,
     q: &mut QueryState,
     obs: &mut O,
 ) -> bool {

@@ -1,6 +1,6 @@
 use super::{cross, kd_leaf, scene_interval, Crossing, KdRoot, SHORT_STACK_MAX};
 use crate::bvh2::NodeRef;
-use crate::intersect::{RayContext, TriangleTest};
+use crate::intersect::{KdRayContext, NoPair, TriangleTest};
 use crate::kd::KdMemory;
 use crate::observe::{Backtrack, Observer};
 use crate::traverse::{begin, Query, QueryState};
@@ -40,13 +40,13 @@ pub fn trace_kd_packet<const W: usize, M: KdMemory + ?Sized, T: TriangleTest, O:
 ) {
     let n = rays.len().min(W).min(hits.len()).min(obs.len());
     let capacity = capacity.min(SHORT_STACK_MAX);
-    let mut ctx: [Option<RayContext<T>>; W] = core::array::from_fn(|_| None);
+    let mut ctx: [Option<KdRayContext<T>>; W] = core::array::from_fn(|_| None);
     let mut q: [QueryState; W] = core::array::from_fn(|i| QueryState::new(&rays[i.min(n.saturating_sub(1))], any));
     let (mut t_min, mut t_max, mut scene_max) = ([0.0f32; W], [0.0f32; W], [0.0f32; W]);
     let mut done = [true; W];
     for i in 0..n {
         let query = if any { Query::Any } else { Query::Closest };
-        if let Some((c, qi)) = begin::<T>(&rays[i], root.scene_scale, query) {
+        if let Some((c, qi)) = begin::<T, NoPair>(&rays[i], root.scene_scale, query) {
             if let Some((a, b)) = scene_interval(&c, root) {
                 (t_min[i], t_max[i], scene_max[i], done[i]) = (a, b, b, false);
                 (ctx[i], q[i]) = (Some(c), qi);

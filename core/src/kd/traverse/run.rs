@@ -1,5 +1,5 @@
 use super::{KdRestartState, KdStackState};
-use crate::intersect::{RayContext, TriangleTest};
+use crate::intersect::{KdRayContext, NoPair, TriangleTest};
 use crate::kd::KdMemory;
 use crate::observe::Observer;
 use crate::traverse::{begin, Method, Query, Step};
@@ -27,7 +27,7 @@ pub struct KdRoot {
 /// ray's interval is widened by its slack as for BVH2 boxes (see
 /// [`RayContext::box_interval`]).
 #[inline(always)]
-pub fn scene_interval<T: TriangleTest>(ctx: &RayContext<T>, root: &KdRoot) -> Option<(f32, f32)> {
+pub fn scene_interval<T: TriangleTest>(ctx: &KdRayContext<T>, root: &KdRoot) -> Option<(f32, f32)> {
     let (lo, hi) = ctx.box_interval(ctx.ray.tmax);
     ctx.slab.hit(root.lo, root.hi, lo, hi).map(|h| (h.t_enter, h.t_exit))
 }
@@ -43,7 +43,7 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
     query: Query,
     obs: &mut O,
 ) -> Hit {
-    let Some((ctx, mut q)) = begin::<T>(ray, root.scene_scale, query) else {
+    let Some((ctx, mut q)) = begin::<T, NoPair>(ray, root.scene_scale, query) else {
         return Hit::MISS;
     };
     let Some((t0, t1)) = scene_interval(&ctx, root) else {

@@ -1,6 +1,6 @@
 use super::{cross, kd_leaf, Crossing};
 use crate::bvh2::NodeRef;
-use crate::intersect::{RayContext, TriangleTest};
+use crate::intersect::{KdRayContext, TriangleTest};
 use crate::kd::KdMemory;
 use crate::observe::{Backtrack, Observer};
 use crate::traverse::{QueryState, Step};
@@ -31,7 +31,7 @@ impl KdStackState {
     pub fn step<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
         &mut self,
         mem: &M,
-        ctx: &RayContext<T>,
+        ctx: &KdRayContext<T>,
         q: &mut QueryState,
         obs: &mut O,
     ) -> Step {
