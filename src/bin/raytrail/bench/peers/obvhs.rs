@@ -85,6 +85,26 @@ impl<T> ObvhsScene<T> {
         Self { tree, triangles, prims }
     }
 
+    /// Builds a tree over `scene` with `build`, timing only that call; `layout` gives the tree's
+    /// primitive order and node bytes. `what` names the build in the report.
+    fn build_with(
+        scene: &Scene,
+        what: &str,
+        build: impl FnOnce(&[ObvhsTriangle]) -> T,
+        layout: impl Fn(&T) -> (&[u32], usize),
+    ) -> (Self, Built) {
+        let tris = obvhs_triangles(scene);
+        let start = Instant::now();
+        let tree = build(&tris);
+        let seconds = start.elapsed().as_secs_f64();
+        let (order, node_bytes) = layout(&tree);
+        let order = order.to_vec();
+        let s = Self::new(tree, &tris, &order);
+        let mut bytes = vec![("nodes".to_string(), node_bytes)];
+        bytes.extend(s.primitive_bytes());
+        (s, Built { what: what.to_string(), seconds, bytes })
+    }
+
     /// Bytes of the reordered triangles and the primitive map.
     fn primitive_bytes(&self) -> Vec<(String, usize)> {
         vec![
@@ -97,30 +117,24 @@ impl<T> ObvhsScene<T> {
 impl ObvhsScene<Bvh2> {
     /// Builds obvhs's BVH2 over `scene` (on the current rayon pool).
     pub fn bvh2(scene: &Scene) -> (Self, Built) {
-        let tris = obvhs_triangles(scene);
-        let start = Instant::now();
-        let tree = build_bvh2_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
-        let seconds = start.elapsed().as_secs_f64();
-        let order = tree.primitive_indices.clone();
-        let s = Self::new(tree, &tris, &order);
-        let mut bytes = vec![("nodes".to_string(), std::mem::size_of_val(s.tree.nodes.as_slice()))];
-        bytes.extend(s.primitive_bytes());
-        (s, Built { what: "obvhs-bvh2 (PLOC, medium_build)".to_string(), seconds, bytes })
+        Self::build_with(
+            scene,
+            "obvhs-bvh2 (PLOC, medium_build)",
+            |tris| build_bvh2_from_tris(tris, BvhBuildParams::medium_build(), &mut Duration::default()),
+            |t| (&t.primitive_indices, std::mem::size_of_val(t.nodes.as_slice())),
+        )
     }
 }
 
 impl ObvhsScene<CwBvh> {
     /// Builds obvhs's CWBVH over `scene` (on the current rayon pool).
     pub fn cwbvh(scene: &Scene) -> (Self, Built) {
-        let tris = obvhs_triangles(scene);
-        let start = Instant::now();
-        let tree = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
-        let seconds = start.elapsed().as_secs_f64();
-        let order = tree.primitive_indices.clone();
-        let s = Self::new(tree, &tris, &order);
-        let mut bytes = vec![("nodes".to_string(), std::mem::size_of_val(s.tree.nodes.as_slice()))];
-        bytes.extend(s.primitive_bytes());
-        (s, Built { what: "obvhs-cwbvh (PLOC, medium_build)".to_string(), seconds, bytes })
+        Self::build_with(
+            scene,
+            "obvhs-cwbvh (PLOC, medium_build)",
+            |tris| build_cwbvh_from_tris(tris, BvhBuildParams::medium_build(), &mut Duration::default()),
+            |t| (&t.primitive_indices, std::mem::size_of_val(t.nodes.as_slice())),
+        )
     }
 }
 
