@@ -14,7 +14,7 @@ pub struct KdRoot {
     pub lo: Vec3,
     /// Upper corner.
     pub hi: Vec3,
-    /// Largest coordinate magnitude in the scene (for [`RayContext::new`]).
+    /// Largest coordinate magnitude in the scene (for [`RayContext::new`](crate::intersect::RayContext::new)).
     pub scene_scale: f32,
     /// Steps after which traversal stops (it never binds on an intact tree; see
     /// [`TraceRoot`](crate::traverse::TraceRoot)).
@@ -25,7 +25,7 @@ pub struct KdRoot {
 
 /// The ray's segment inside the tree's box, `[scene_min, scene_max]`, if it meets the box; the
 /// ray's interval is widened by its slack as for BVH2 boxes (see
-/// [`RayContext::box_interval`]).
+/// [`RayContext::box_interval`](crate::intersect::RayContext::box_interval)).
 #[inline(always)]
 pub fn scene_interval<T: TriangleTest>(ctx: &KdRayContext<T>, root: &KdRoot) -> Option<(f32, f32)> {
     let (lo, hi) = ctx.box_interval(ctx.ray.tmax);
