@@ -46,7 +46,7 @@ impl SlabRay {
     ///
     /// Near and far planes are picked by the direction's sign bit, so a `±0` component yields
     /// `±inf` distances rather than swapping planes. A `0 * inf` NaN (origin on a plane of a slab
-    /// the ray runs parallel to) is ignored by [`keep_max`]/[`keep_min`], which keep the
+    /// the ray runs parallel to) is ignored by `keep_max`/`keep_min`, which keep the
     /// accumulator when the candidate is NaN: the accumulators start from `tmin`/`tmax`, never NaN
     /// for a traceable ray, so a NaN never turns a hit into a miss.
     #[inline(always)]
