@@ -13,7 +13,36 @@ pub(crate) struct Pipelines {
     compiled: Mutex<HashMap<Variant, Arc<wgpu::ComputePipeline>>>,
 }
 
-pub(crate) fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+/// A one-group layout of buffer bindings `0..kinds.len()` (`read_only: None` is a uniform), and the
+/// pipeline layout of that group: what every kernel, and the numerics probe, binds.
+pub(crate) fn buffer_layout(
+    gpu: &Gpu,
+    label: &str,
+    kinds: &[Option<bool>],
+) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout) {
+    let entries: Vec<_> = (0u32..)
+        .zip(kinds)
+        .map(|(binding, kind)| {
+            entry(
+                binding,
+                match *kind {
+                    None => wgpu::BufferBindingType::Uniform,
+                    Some(read_only) => wgpu::BufferBindingType::Storage { read_only },
+                },
+            )
+        })
+        .collect();
+    let bind_layout =
+        gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
+    let layout = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(&bind_layout)],
+        immediate_size: 0,
+    });
+    (bind_layout, layout)
+}
+
+fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
@@ -24,25 +53,10 @@ pub(crate) fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGrou
 
 impl Pipelines {
     pub fn new(gpu: &Gpu) -> Pipelines {
-        let read = wgpu::BufferBindingType::Storage { read_only: true };
-        let write = wgpu::BufferBindingType::Storage { read_only: false };
-        let entries = [
-            entry(0, wgpu::BufferBindingType::Uniform),
-            entry(1, read),
-            entry(2, write),
-            entry(3, read),
-            entry(4, read),
-            entry(5, read),
-            entry(6, write),
-        ];
-        let bind_layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("raytrail"), entries: &entries });
-        let layout = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("raytrail"),
-            bind_group_layouts: &[Some(&bind_layout)],
-            immediate_size: 0,
-        });
+        // shaders/prelude.wgsl: parameters, rays (read), hits (write), three scene buffers (read),
+        // records (write).
+        let (read, write) = (Some(true), Some(false));
+        let (bind_layout, layout) = buffer_layout(gpu, "raytrail", &[None, read, write, read, read, read, write]);
         Pipelines { bind_layout, layout, compiled: Mutex::new(HashMap::new()) }
     }
 

@@ -4,7 +4,7 @@
 //! matches the CPU bit for bit. NUMERICS.md explains what the kernels do about each.
 
 use crate::device::{device_error, Gpu};
-use crate::pipelines::entry;
+use crate::pipelines::buffer_layout;
 use raytrail_core::Error;
 use wgpu::util::DeviceExt;
 
@@ -84,18 +84,8 @@ pub(crate) fn probe(gpu: &Gpu, n: usize) -> Result<NumericsProbe, Error> {
     let input = samples(n);
     let d = &gpu.device;
     let out: Vec<[u32; 4]> = gpu.checked("running the numerics probe", || -> Result<Vec<[u32; 4]>, Error> {
-        let read = wgpu::BufferBindingType::Storage { read_only: true };
-        let write = wgpu::BufferBindingType::Storage { read_only: false };
-        let entries = [entry(0, wgpu::BufferBindingType::Uniform), entry(1, read), entry(2, write)];
-        let bind_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("numerics probe"),
-            entries: &entries,
-        });
-        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("numerics probe"),
-            bind_group_layouts: &[Some(&bind_layout)],
-            immediate_size: 0,
-        });
+        // shaders/probe.wgsl: a uniform, the samples (read), the results (write).
+        let (bind_layout, layout) = buffer_layout(gpu, "numerics probe", &[None, Some(true), Some(false)]);
         // Compiled as the kernels are, so it measures what they get.
         let pipeline = gpu.compute_pipeline("numerics probe", &source, &[], &layout)?;
         let bytes = (input.len() * 16) as u64;
