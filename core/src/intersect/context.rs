@@ -90,20 +90,14 @@ impl<T: TriangleTest, B: BoxConstants> RayContext<T, B> {
     /// meshes end to end.
     #[inline]
     pub fn new(ray: &Ray, scene_scale: f32) -> Self {
-        let reach = scene_scale + ray.origin().abs().max_element();
-        let slab = SlabRay::new(ray);
-        // `1 / |d|` without a division of its own: rounding is monotonic, so the smallest
-        // `|1 / d_i|` is exactly `1 / max |d_i|` rounded (zero components give `inf`, never the
-        // smallest for a traceable ray). A scalar division here was a fifth of the time of a ray
-        // that leaves the scene after a node or two.
-        let reach_per_d = reach * slab.inv_dir.abs().min_element();
-        // The watertight test forms products of order reach^3 / |d|; where they come near the
-        // float range its `t` is unreliable: the slack is then infinite (see `is_reliable`).
-        // Scaling by the power of two `SLACK_SCALE` is exact.
-        let t_slack =
-            if reach * reach * reach_per_d < RELIABLE_LIMIT { reach_per_d * SLACK_SCALE } else { f32::INFINITY };
-        let slab = SlabRay { slack: t_slack, ..slab };
-        Self { ray: *ray, slab, pair: B::from_slab(&slab), tri: Cell::new(None), t_slack }
+        Self::from_slab(ray, SlabRay::with_slack(ray, scene_scale))
+    }
+
+    /// The context of `ray` around its slab constants `slab`, made by [`SlabRay::with_slack`]
+    /// (a traversal may test its first box with them before it pays for the rest).
+    #[inline(always)]
+    pub fn from_slab(ray: &Ray, slab: SlabRay) -> Self {
+        Self { ray: *ray, slab, pair: B::from_slab(&slab), tri: Cell::new(None), t_slack: slab.slack }
     }
 
     /// The triangle test's per-ray constants, made on the first call.
@@ -132,6 +126,34 @@ impl<T: TriangleTest, B: BoxConstants> RayContext<T, B> {
     /// triangle inside it could still yield a computed `t` within `[tmin, limit]`.
     #[inline(always)]
     pub fn box_interval(&self, limit: f32) -> (f32, f32) {
-        (self.ray.tmin - self.t_slack, limit + self.t_slack)
+        self.slab.widen(self.ray.tmin, limit)
+    }
+}
+
+impl SlabRay {
+    /// The slab constants of a traceable ray ([`Ray::is_traceable`]) with their slack set to the
+    /// [`RayContext::t_slack`] of a scene whose largest coordinate magnitude is `scene_scale`
+    /// (infinite where the ray is not reliable; see [`RayContext::new`]).
+    #[inline(always)]
+    pub fn with_slack(ray: &Ray, scene_scale: f32) -> Self {
+        let reach = scene_scale + ray.origin().abs().max_element();
+        let slab = SlabRay::new(ray);
+        // `1 / |d|` without a division of its own: rounding is monotonic, so the smallest
+        // `|1 / d_i|` is exactly `1 / max |d_i|` rounded (zero components give `inf`, never the
+        // smallest for a traceable ray). A scalar division here was a fifth of the time of a ray
+        // that leaves the scene after a node or two.
+        let reach_per_d = reach * slab.inv_dir.abs().min_element();
+        // The watertight test forms products of order reach^3 / |d|; where they come near the
+        // float range its `t` is unreliable: the slack is then infinite (see `is_reliable`).
+        // Scaling by the power of two `SLACK_SCALE` is exact.
+        let slack =
+            if reach * reach * reach_per_d < RELIABLE_LIMIT { reach_per_d * SLACK_SCALE } else { f32::INFINITY };
+        SlabRay { slack, ..slab }
+    }
+
+    /// `[tmin, limit]` widened by the slack on both ends (see [`RayContext::box_interval`]).
+    #[inline(always)]
+    pub fn widen(&self, tmin: f32, limit: f32) -> (f32, f32) {
+        (tmin - self.slack, limit + self.slack)
     }
 }

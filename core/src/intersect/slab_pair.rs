@@ -41,12 +41,12 @@ impl SlabPair {
     }
 }
 
-/// The scalar reference: [`SlabRay::hit`] on each child box in turn.
+/// The scalar reference: [`SlabRay::hit_scalar`] on each child box in turn.
 #[inline(always)]
 pub fn hit_pair_scalar(slab: &SlabRay, node: &BinaryNode, tmin: f32, tmax: f32) -> [Option<BoxHit>; 2] {
     let (l0, l1) = node.child_bounds(0);
     let (r0, r1) = node.child_bounds(1);
-    [slab.hit(l0, l1, tmin, tmax), slab.hit(r0, r1, tmin, tmax)]
+    [slab.hit_scalar(l0, l1, tmin, tmax), slab.hit_scalar(r0, r1, tmin, tmax)]
 }
 
 /// The SSE2 path (every x86_64 CPU has SSE2, so no run-time detection is needed).
@@ -182,39 +182,8 @@ mod sse {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::intersect::test_values::{same, Rng};
     use crate::Ray;
-
-    /// A small deterministic generator (xorshift).
-    struct Rng(u64);
-
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-        /// Mostly ordinary values, with zeros of both signs, infinities, NaN and exact repeats.
-        fn value(&mut self, pool: &[f32]) -> f32 {
-            match self.next() % 16 {
-                0 => 0.0,
-                1 => -0.0,
-                2 => pool[(self.next() % pool.len() as u64) as usize],
-                3 => [f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 1e-40][(self.next() % 4) as usize],
-                _ => ((self.next() % 2001) as f32 - 1000.0) / 256.0,
-            }
-        }
-    }
-
-    fn same(a: Option<BoxHit>, b: Option<BoxHit>) -> bool {
-        match (a, b) {
-            (None, None) => true,
-            (Some(a), Some(b)) => {
-                a.t_enter.to_bits() == b.t_enter.to_bits() && a.t_exit.to_bits() == b.t_exit.to_bits()
-            }
-            _ => false,
-        }
-    }
 
     #[test]
     fn matches_the_scalar_test_bit_for_bit() {

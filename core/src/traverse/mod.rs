@@ -33,7 +33,7 @@ pub use parent_sibling::ParentSiblingState;
 pub use query::QueryState;
 pub use register::{Fallback, PerfectHashLookup, RegisterState, UncleHops};
 pub use resume::{trace_pausing, Paused};
-pub use run::{begin, trace_batch, trace_ray, TraceRoot};
+pub use run::{begin, begin_slab, trace_batch, trace_ray, TraceRoot};
 pub use stack::StackState;
 
 /// What a step leaves to do.

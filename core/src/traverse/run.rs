@@ -3,7 +3,7 @@ use super::{
     StackState, Step, UncleHops,
 };
 use crate::bvh2::{BvhMemory, NodeRef};
-use crate::intersect::{BoxConstants, RayContext, SlabPair, TriangleTest};
+use crate::intersect::{BoxConstants, RayContext, SlabPair, SlabRay, TriangleTest};
 use crate::key::Key;
 use crate::observe::Observer;
 use crate::{Hit, Ray};
@@ -28,11 +28,20 @@ pub fn begin<T: TriangleTest, B: BoxConstants>(
     scene_scale: f32,
     query: Query,
 ) -> Option<(RayContext<T, B>, QueryState)> {
+    let slab = begin_slab(ray, scene_scale)?;
+    Some((RayContext::from_slab(ray, slab), QueryState::new(ray, query == Query::Any)))
+}
+
+/// The first stage of [`begin`]: the slab constants with their slack, or `None` where `begin`
+/// turns the ray away. A traversal that tests one box first (the kd-tree's scene box) makes the
+/// rest of the context only for rays that enter it.
+#[inline(always)]
+pub fn begin_slab(ray: &Ray, scene_scale: f32) -> Option<SlabRay> {
     if !ray.is_traceable() {
         return None;
     }
-    let ctx = RayContext::<T, B>::new(ray, scene_scale);
-    ctx.is_reliable().then(|| (ctx, QueryState::new(ray, query == Query::Any)))
+    let slab = SlabRay::with_slack(ray, scene_scale);
+    slab.slack.is_finite().then_some(slab)
 }
 
 /// Traces one ray with `method` over `mem` (which must hold what the method needs: the

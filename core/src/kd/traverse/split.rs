@@ -35,7 +35,10 @@ pub enum Crossing {
 #[inline(always)]
 pub fn cross(node: &KdNode, slab: &SlabRay, t_min: f32, t_max: f32) -> Crossing {
     let a = node.axis();
-    let t_split = (node.value - slab.origin[a]) * slab.inv_dir[a];
+    // Indexed as arrays: glam's `Index` is a `match` on the axis, which compiled to branches
+    // that the axes of successive nodes mispredict.
+    let (origin, inv_dir): (&[f32; 3], &[f32; 3]) = (slab.origin.as_ref(), slab.inv_dir.as_ref());
+    let t_split = (node.value - origin[a]) * inv_dir[a];
     let below = node.below();
     let (first, second) = if slab.negative[a] { (below + 1, below) } else { (below, below + 1) };
     if t_split >= t_max || t_split.is_nan() {
