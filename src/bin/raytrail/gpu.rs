@@ -47,7 +47,7 @@ impl Gpu {
         for _ in 0..passes {
             times.push(self.backend.trace(&self.scene, rays, &opts, &mut hits).map_err(|e| e.to_string())?.seconds);
         }
-        Ok(crate::run::median(&mut times))
+        Ok(crate::median::median(&times))
     }
 
     /// Every method on `rays` on the GPU: against its reference there, and against the CPU.

@@ -3,6 +3,7 @@
 mod args;
 mod bench;
 mod gpu;
+mod median;
 mod progress;
 mod run;
 mod trace;

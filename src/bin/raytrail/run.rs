@@ -2,6 +2,7 @@
 //! report speed, work per ray, state size, hash-table figures and the conformance verdict.
 
 use crate::args::Args;
+use crate::median::median;
 use crate::progress::{timed, Progress};
 use raytrail::conformance::check::{check_ray_set, Context, Mismatch};
 use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
@@ -94,7 +95,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             opts.record = Record::Counters;
             let counted = backend.trace(&cpu, &set.rays, &opts, &mut hits).map_err(|e| e.to_string())?;
             progress.step(&format!("{} {} counters", set.name, method));
-            rows.push((method, median(&mut times), counted.counters.unwrap_or_default()));
+            rows.push((method, median(&times), counted.counters.unwrap_or_default()));
         }
         // Conformance on an evenly spread subset: recording every node of every ray is heavy.
         let step = set.rays.len().div_ceil(check_rays.max(1)).max(1);
@@ -140,12 +141,6 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         }
         Ok(1)
     }
-}
-
-/// The median of `v` (sorted in place).
-pub fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn ray_sets(

@@ -14,8 +14,9 @@
 
 use super::agreement::{compare, Agreement};
 use super::rays::RayBatch;
-use super::report::{median, RayReport, Row};
+use super::report::{RayReport, Row};
 use super::target::BenchTarget;
+use crate::median::median;
 use crate::progress::Progress;
 use raytrail::core::geometry::Triangle;
 use raytrail::core::Hit;

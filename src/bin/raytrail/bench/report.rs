@@ -82,13 +82,6 @@ pub struct BenchReport {
     pub scenes: Vec<SceneReport>,
 }
 
-/// Median of `v` (the upper one of the middle two for an even count); 0 for none.
-pub fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s.get(s.len() / 2).copied().unwrap_or(0.0)
-}
-
 /// Megabytes (2^20 bytes).
 pub fn mb(bytes: usize) -> f64 {
     bytes as f64 / (1024.0 * 1024.0)
