@@ -15,9 +15,9 @@
 //! with backface culling and an absolute epsilon (`f32::EPSILON`) on the determinant, so it also
 //! rejects triangles whose area across the ray is below that: many of the dragon's.
 
-use super::{par_trace, Variant};
+use super::PeerTree;
 use crate::bench::report::Built;
-use crate::bench::target::{BenchTarget, TargetKind, Work};
+use crate::bench::target::Work;
 use bvh::aabb::{Aabb, Bounded};
 use bvh::bounding_hierarchy::{BHShape, BoundingHierarchy};
 use bvh::bvh::{Bvh, BvhNode};
@@ -26,9 +26,7 @@ use glam::Vec3;
 use nalgebra::{Point3, Vector3};
 use raytrail::core::intersect::{TriangleTest, Watertight};
 use raytrail::core::scene::Scene;
-use raytrail::core::traverse::Query;
 use raytrail::core::{Hit, Ray};
-use std::sync::Arc;
 use std::time::Instant;
 
 /// Deepest tree (root at depth 0) the crate's stack iterator can walk without overflowing.
@@ -110,23 +108,11 @@ fn depth(bvh: &Bvh<f32, 3>) -> usize {
     deepest
 }
 
-/// The crate's BVH traced with one triangle test.
-pub struct BvhTarget {
-    name: String,
-    scene: Arc<BvhScene>,
-    variant: Variant,
-}
-
-impl BvhTarget {
-    /// The target `peer` (plus the variant's suffix) over `scene`.
-    pub fn new(peer: &str, scene: Arc<BvhScene>, variant: Variant) -> Self {
-        Self { name: format!("{peer}{}", variant.suffix()), scene, variant }
-    }
-
+impl PeerTree for BvhScene {
     /// Closest hit of one ray and the triangle tests made (counted when `COUNT`).
     #[inline(always)]
     fn closest<const WT: bool, const COUNT: bool>(&self, ray: &Ray) -> (Hit, u64) {
-        let s = &*self.scene;
+        let s = self;
         let (br, len) = bvh_ray(ray);
         let sheared = WT.then(|| Watertight::prepare(ray));
         let (mut best, mut tests) = (Hit::MISS, 0u64);
@@ -164,87 +150,50 @@ impl BvhTarget {
     /// Any hit of one ray and the triangle tests made (counted when `COUNT`).
     #[inline(always)]
     fn any<const WT: bool, const COUNT: bool>(&self, ray: &Ray) -> (Hit, u64) {
-        let s = &*self.scene;
+        let s = self;
         let (br, _) = bvh_ray(ray);
         if s.shallow {
-            self.first_hit::<WT, COUNT>(ray, &br, s.bvh.traverse_iterator(&br, &s.shapes))
+            first_hit::<WT, COUNT>(ray, &br, s.bvh.traverse_iterator(&br, &s.shapes))
         } else {
-            self.first_hit::<WT, COUNT>(ray, &br, s.bvh.nearest_traverse_iterator(&br, &s.shapes))
+            first_hit::<WT, COUNT>(ray, &br, s.bvh.nearest_traverse_iterator(&br, &s.shapes))
         }
     }
 
-    /// The first hit among `candidates` within the ray's interval.
-    #[inline(always)]
-    fn first_hit<'a, const WT: bool, const COUNT: bool>(
-        &self,
-        ray: &Ray,
-        br: &BvhRay<f32, 3>,
-        candidates: impl Iterator<Item = &'a BvhTriangle>,
-    ) -> (Hit, u64) {
-        let len = ray.dir().length();
-        let sheared = WT.then(|| Watertight::prepare(ray));
-        let mut tests = 0u64;
-        for tri in candidates {
-            tests += u64::from(COUNT);
-            match &sheared {
-                Some(sh) => {
-                    let [a, b, c] = tri.v.map(|p| Vec3::new(p.x, p.y, p.z));
-                    if let Some(h) = Watertight::intersect(sh, a, b, c, ray.tmin, ray.tmax) {
-                        return (Hit { t: h.t, prim: tri.prim, u: h.u, v: h.v }, tests);
-                    }
-                }
-                None => {
-                    let x = br.intersects_triangle(&tri.v[0], &tri.v[1], &tri.v[2]);
-                    let t = x.distance / len;
-                    if t >= ray.tmin && t <= ray.tmax {
-                        return (Hit { t, prim: tri.prim, u: x.u, v: x.v }, tests);
-                    }
-                }
-            }
-        }
-        (Hit::MISS, tests)
-    }
-
-    /// Traces every ray; returns the triangle tests made (0 unless `COUNT`).
-    fn run<const COUNT: bool>(
-        &self,
-        pool: &rayon::ThreadPool,
-        rays: &[Ray],
-        query: Query,
-        hits: &mut [Hit],
-    ) -> Result<u64, String> {
-        match (self.variant, query) {
-            (Variant::Own, Query::Closest) => par_trace(pool, rays, hits, |r| self.closest::<false, COUNT>(r)),
-            (Variant::Own, Query::Any) => par_trace(pool, rays, hits, |r| self.any::<false, COUNT>(r)),
-            (Variant::Watertight, Query::Closest) => par_trace(pool, rays, hits, |r| self.closest::<true, COUNT>(r)),
-            (Variant::Watertight, Query::Any) => par_trace(pool, rays, hits, |r| self.any::<true, COUNT>(r)),
-        }
+    /// One triangle per leaf: every leaf reached is one test.
+    fn work(tests_per_ray: f64) -> Work {
+        Work { leaves: Some(tests_per_ray), tests: Some(tests_per_ray), nodes: None }
     }
 }
 
-impl BenchTarget for BvhTarget {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn kind(&self) -> TargetKind {
-        match self.variant {
-            Variant::Own => TargetKind::PeerOwnTest,
-            Variant::Watertight => TargetKind::PeerWatertight,
+/// The first hit among `candidates` within the ray's interval.
+#[inline(always)]
+fn first_hit<'a, const WT: bool, const COUNT: bool>(
+    ray: &Ray,
+    br: &BvhRay<f32, 3>,
+    candidates: impl Iterator<Item = &'a BvhTriangle>,
+) -> (Hit, u64) {
+    let len = ray.dir().length();
+    let sheared = WT.then(|| Watertight::prepare(ray));
+    let mut tests = 0u64;
+    for tri in candidates {
+        tests += u64::from(COUNT);
+        match &sheared {
+            Some(sh) => {
+                let [a, b, c] = tri.v.map(|p| Vec3::new(p.x, p.y, p.z));
+                if let Some(h) = Watertight::intersect(sh, a, b, c, ray.tmin, ray.tmax) {
+                    return (Hit { t: h.t, prim: tri.prim, u: h.u, v: h.v }, tests);
+                }
+            }
+            None => {
+                let x = br.intersects_triangle(&tri.v[0], &tri.v[1], &tri.v[2]);
+                let t = x.distance / len;
+                if t >= ray.tmin && t <= ray.tmax {
+                    return (Hit { t, prim: tri.prim, u: x.u, v: x.v }, tests);
+                }
+            }
         }
     }
-
-    fn trace(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<(), String> {
-        self.run::<false>(pool, rays, query, hits).map(|_| ())
-    }
-
-    fn work(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String> {
-        let mut hits = vec![Hit::MISS; rays.len()];
-        let tests = self.run::<true>(pool, rays, query, &mut hits)?;
-        // One triangle per leaf: every leaf reached is one test.
-        let per_ray = tests as f64 / rays.len().max(1) as f64;
-        Ok(Some(Work { leaves: Some(per_ray), tests: Some(per_ray), nodes: None }))
-    }
+    (Hit::MISS, tests)
 }
 
 /// A raytrail ray as the crate takes it (normalized direction), and the direction's length.

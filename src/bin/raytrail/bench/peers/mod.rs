@@ -10,9 +10,10 @@ mod bvh_crate;
 mod obvhs;
 
 use super::report::Built;
-use super::target::Targets;
+use super::target::{BenchTarget, TargetKind, Targets, Work};
 use rayon::prelude::*;
 use raytrail::core::scene::Scene;
+use raytrail::core::traverse::Query;
 use raytrail::core::{Hit, Ray};
 use std::sync::Arc;
 
@@ -44,32 +45,92 @@ pub fn build(names: &[String], scene: &Scene, pool: &rayon::ThreadPool) -> Resul
     let mut targets: Targets = Vec::new();
     let mut built = Vec::new();
     for name in names {
-        match name.as_str() {
-            "obvhs-bvh2" => {
-                let (tree, b) = pool.install(|| obvhs::ObvhsScene::bvh2(scene));
-                let tree = Arc::new(tree);
-                targets.push(Box::new(obvhs::ObvhsTarget::new(name, tree.clone(), Variant::Own)));
-                targets.push(Box::new(obvhs::ObvhsTarget::new(name, tree, Variant::Watertight)));
-                built.push(b);
-            }
-            "obvhs-cwbvh" => {
-                let (tree, b) = pool.install(|| obvhs::ObvhsScene::cwbvh(scene));
-                let tree = Arc::new(tree);
-                targets.push(Box::new(obvhs::ObvhsTarget::new(name, tree.clone(), Variant::Own)));
-                targets.push(Box::new(obvhs::ObvhsTarget::new(name, tree, Variant::Watertight)));
-                built.push(b);
-            }
-            "bvh" => {
-                let (tree, b) = pool.install(|| bvh_crate::BvhScene::new(scene));
-                let tree = Arc::new(tree);
-                targets.push(Box::new(bvh_crate::BvhTarget::new(name, tree.clone(), Variant::Own)));
-                targets.push(Box::new(bvh_crate::BvhTarget::new(name, tree, Variant::Watertight)));
-                built.push(b);
-            }
+        let b = match name.as_str() {
+            "obvhs-bvh2" => both_variants(name, pool.install(|| obvhs::ObvhsScene::bvh2(scene)), &mut targets),
+            "obvhs-cwbvh" => both_variants(name, pool.install(|| obvhs::ObvhsScene::cwbvh(scene)), &mut targets),
+            "bvh" => both_variants(name, pool.install(|| bvh_crate::BvhScene::new(scene)), &mut targets),
             other => return Err(format!("unknown peer '{other}'")),
-        }
+        };
+        built.push(b);
     }
     Ok((targets, built))
+}
+
+/// Adds the two targets of a built peer tree (its own test, then raytrail's watertight one);
+/// returns what the build cost.
+fn both_variants<P: PeerTree>(name: &str, (tree, built): (P, Built), targets: &mut Targets) -> Built {
+    let tree = Arc::new(tree);
+    targets.push(Box::new(PeerTarget::new(name, tree.clone(), Variant::Own)));
+    targets.push(Box::new(PeerTarget::new(name, tree, Variant::Watertight)));
+    built
+}
+
+/// A peer's tree: one ray's closest hit or any hit through the peer's traversal, with the peer's
+/// own triangle test or, when `WT`, raytrail's watertight test and tie rule; each returns the hit
+/// and the triangle tests made (counted only when `COUNT`).
+pub trait PeerTree: Send + Sync + 'static {
+    /// Closest hit of one ray.
+    fn closest<const WT: bool, const COUNT: bool>(&self, ray: &Ray) -> (Hit, u64);
+    /// Any hit of one ray.
+    fn any<const WT: bool, const COUNT: bool>(&self, ray: &Ray) -> (Hit, u64);
+    /// The work per ray this peer can report, from its triangle tests per ray.
+    fn work(tests_per_ray: f64) -> Work {
+        Work { tests: Some(tests_per_ray), ..Work::default() }
+    }
+}
+
+/// One peer tree traced with one triangle test: a bench target.
+pub struct PeerTarget<P> {
+    name: String,
+    tree: Arc<P>,
+    variant: Variant,
+}
+
+impl<P: PeerTree> PeerTarget<P> {
+    /// The target `peer` (plus the variant's suffix) over `tree`.
+    pub fn new(peer: &str, tree: Arc<P>, variant: Variant) -> Self {
+        Self { name: format!("{peer}{}", variant.suffix()), tree, variant }
+    }
+
+    /// Traces every ray; returns the triangle tests made (0 unless `COUNT`).
+    fn run<const COUNT: bool>(
+        &self,
+        pool: &rayon::ThreadPool,
+        rays: &[Ray],
+        query: Query,
+        hits: &mut [Hit],
+    ) -> Result<u64, String> {
+        let t = &*self.tree;
+        match (self.variant, query) {
+            (Variant::Own, Query::Closest) => par_trace(pool, rays, hits, |r| t.closest::<false, COUNT>(r)),
+            (Variant::Own, Query::Any) => par_trace(pool, rays, hits, |r| t.any::<false, COUNT>(r)),
+            (Variant::Watertight, Query::Closest) => par_trace(pool, rays, hits, |r| t.closest::<true, COUNT>(r)),
+            (Variant::Watertight, Query::Any) => par_trace(pool, rays, hits, |r| t.any::<true, COUNT>(r)),
+        }
+    }
+}
+
+impl<P: PeerTree> BenchTarget for PeerTarget<P> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn kind(&self) -> TargetKind {
+        match self.variant {
+            Variant::Own => TargetKind::PeerOwnTest,
+            Variant::Watertight => TargetKind::PeerWatertight,
+        }
+    }
+
+    fn trace(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<(), String> {
+        self.run::<false>(pool, rays, query, hits).map(|_| ())
+    }
+
+    fn work(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String> {
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let tests = self.run::<true>(pool, rays, query, &mut hits)?;
+        Ok(Some(P::work(tests as f64 / rays.len().max(1) as f64)))
+    }
 }
 
 /// Traces every ray with `one` (returning its hit and the triangle tests it made) in chunks of

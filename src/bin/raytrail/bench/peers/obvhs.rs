@@ -11,9 +11,8 @@
 //! to whichever triangle was tested first), and an any-hit query stops at a hit strictly before
 //! `tmax`. Its triangle test is Möller-Trumbore without backface culling.
 
-use super::{par_trace, Variant};
+use super::PeerTree;
 use crate::bench::report::Built;
-use crate::bench::target::{BenchTarget, TargetKind, Work};
 use glam::{Vec3, Vec3A};
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::bvh2::Bvh2;
@@ -24,9 +23,7 @@ use obvhs::triangle::Triangle as ObvhsTriangle;
 use obvhs::BvhBuildParams;
 use raytrail::core::intersect::{TriangleTest, Watertight};
 use raytrail::core::scene::Scene;
-use raytrail::core::traverse::Query;
 use raytrail::core::{Hit, Ray};
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// obvhs's closest-hit and occlusion traversals, the same for both of its trees.
@@ -138,23 +135,11 @@ impl ObvhsScene<CwBvh> {
     }
 }
 
-/// One obvhs tree traced with one triangle test.
-pub struct ObvhsTarget<T> {
-    name: String,
-    scene: Arc<ObvhsScene<T>>,
-    variant: Variant,
-}
-
-impl<T: ObvhsTree> ObvhsTarget<T> {
-    /// The target `peer` (plus the variant's suffix) over `scene`.
-    pub fn new(peer: &str, scene: Arc<ObvhsScene<T>>, variant: Variant) -> Self {
-        Self { name: format!("{peer}{}", variant.suffix()), scene, variant }
-    }
-
+impl<T: ObvhsTree> PeerTree for ObvhsScene<T> {
     /// Closest hit of one ray and the triangle tests made (counted when `COUNT`).
     #[inline(always)]
     fn closest<const WT: bool, const COUNT: bool>(&self, ray: &Ray) -> (Hit, u64) {
-        let s = &*self.scene;
+        let s = self;
         let sheared = WT.then(|| Watertight::prepare(ray));
         let (mut best, mut tests, mut found) = (Hit::MISS, 0u64, RayHit::none());
         s.tree.closest(obvhs_ray(ray), &mut found, |r, slot| {
@@ -183,7 +168,7 @@ impl<T: ObvhsTree> ObvhsTarget<T> {
     /// Any hit of one ray and the triangle tests made (counted when `COUNT`).
     #[inline(always)]
     fn any<const WT: bool, const COUNT: bool>(&self, ray: &Ray) -> (Hit, u64) {
-        let s = &*self.scene;
+        let s = self;
         let sheared = WT.then(|| Watertight::prepare(ray));
         let (mut found, mut tests) = (Hit::MISS, 0u64);
         s.tree.occluded(obvhs_ray(ray), |r, slot| {
@@ -208,45 +193,6 @@ impl<T: ObvhsTree> ObvhsTarget<T> {
             }
         });
         (found, tests)
-    }
-
-    /// Traces every ray; returns the triangle tests made (0 unless `COUNT`).
-    fn run<const COUNT: bool>(
-        &self,
-        pool: &rayon::ThreadPool,
-        rays: &[Ray],
-        query: Query,
-        hits: &mut [Hit],
-    ) -> Result<u64, String> {
-        match (self.variant, query) {
-            (Variant::Own, Query::Closest) => par_trace(pool, rays, hits, |r| self.closest::<false, COUNT>(r)),
-            (Variant::Own, Query::Any) => par_trace(pool, rays, hits, |r| self.any::<false, COUNT>(r)),
-            (Variant::Watertight, Query::Closest) => par_trace(pool, rays, hits, |r| self.closest::<true, COUNT>(r)),
-            (Variant::Watertight, Query::Any) => par_trace(pool, rays, hits, |r| self.any::<true, COUNT>(r)),
-        }
-    }
-}
-
-impl<T: ObvhsTree> BenchTarget for ObvhsTarget<T> {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn kind(&self) -> TargetKind {
-        match self.variant {
-            Variant::Own => TargetKind::PeerOwnTest,
-            Variant::Watertight => TargetKind::PeerWatertight,
-        }
-    }
-
-    fn trace(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<(), String> {
-        self.run::<false>(pool, rays, query, hits).map(|_| ())
-    }
-
-    fn work(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String> {
-        let mut hits = vec![Hit::MISS; rays.len()];
-        let tests = self.run::<true>(pool, rays, query, &mut hits)?;
-        Ok(Some(Work { tests: Some(tests as f64 / rays.len().max(1) as f64), ..Work::default() }))
     }
 }
 
