@@ -183,19 +183,14 @@ mod sse {
 mod tests {
     use super::*;
     use crate::intersect::test_values::{same, Rng};
-    use crate::Ray;
 
     #[test]
     fn matches_the_scalar_test_bit_for_bit() {
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-        let pool = [0.5f32, -0.25, 1.0, 3.0];
         let mut hits = 0;
         for _ in 0..200_000 {
-            let mut v = || rng.value(&pool);
-            let ray = Ray { origin: [v(), v(), v()], tmin: v(), dir: [v(), v(), v()], tmax: v() };
-            let mut slab = SlabRay::new(&ray);
-            slab.slack = [0.0, 1e-5, f32::INFINITY][(rng.next() % 3) as usize];
-            let mut v = || rng.value(&pool);
+            let (ray, slab) = rng.ray_and_slab();
+            let mut v = || rng.adversarial();
             let node = BinaryNode {
                 left_xy: [v(), v(), v(), v()],
                 right_xy: [v(), v(), v(), v()],

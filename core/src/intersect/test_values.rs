@@ -1,6 +1,10 @@
 //! Adversarial inputs for the tests that hold a fast path to its reference bit for bit.
 
-use super::BoxHit;
+use super::{BoxHit, SlabRay};
+use crate::Ray;
+
+/// Values that recur exactly, so that planes and origins coincide.
+const POOL: [f32; 4] = [0.5, -0.25, 1.0, 3.0];
 
 /// A small deterministic generator (xorshift).
 pub struct Rng(pub u64);
@@ -24,6 +28,20 @@ impl Rng {
             3 => [f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 1e-40][(self.next() % 4) as usize],
             _ => ((self.next() % 2001) as f32 - 1000.0) / 256.0,
         }
+    }
+
+    /// [`Rng::value`] over the shared pool of exact repeats.
+    pub fn adversarial(&mut self) -> f32 {
+        self.value(&POOL)
+    }
+
+    /// An adversarial ray (any of its values may be zero, infinite or NaN) and its slab constants
+    /// with a slack of 0, 1e-5 or infinity.
+    pub fn ray_and_slab(&mut self) -> (Ray, SlabRay) {
+        let mut v = || self.adversarial();
+        let ray = Ray { origin: [v(), v(), v()], tmin: v(), dir: [v(), v(), v()], tmax: v() };
+        let slab = SlabRay { slack: [0.0, 1e-5, f32::INFINITY][(self.next() % 3) as usize], ..SlabRay::new(&ray) };
+        (ray, slab)
     }
 }
 
