@@ -5,14 +5,12 @@
 //! monomorphized for the tree's key width, the triangle test and what is recorded, so the fast
 //! path carries no observer at all.
 //!
-//! The crate also holds the std-side helpers: the obvhs (PLOC) BVH2 builder ([`ploc`]) and NumPy
-//! ray and hit files ([`npy`]).
+//! The crate also holds the obvhs (PLOC) BVH2 builder ([`ploc`]).
 #![warn(missing_docs)]
 
 mod backend;
 mod dispatch;
 mod dispatch_kd;
-pub mod npy;
 pub mod ploc;
 
 pub use backend::{CpuBackend, CpuScene};

@@ -12,38 +12,38 @@ use raytrail_core::key::KeyWidth;
 use raytrail_core::trace::{Record, TriangleTestKind};
 use raytrail_core::traverse::{Method, Query};
 
-/// One WGSL file of `shaders/`, by name and text.
+/// One WGSL file of `raytrail-shaders`, by name and text.
 type Part = (&'static str, &'static str);
 
 macro_rules! part {
-    ($name:literal) => {
-        ($name, include_str!(concat!("../../../shaders/", $name)))
+    ($source:ident) => {
+        (raytrail_shaders::$source.name, raytrail_shaders::$source.text)
     };
 }
 
-const PRELUDE: Part = part!("prelude.wgsl");
-const NUMERICS: Part = part!("numerics.wgsl");
-const BOX: Part = part!("box.wgsl");
-const WATERTIGHT: Part = part!("triangle_watertight.wgsl");
-const MOLLER_TRUMBORE: Part = part!("triangle_moller_trumbore.wgsl");
-const QUERY: Part = part!("query.wgsl");
-const RECORD: Part = part!("record.wgsl");
-const BVH_LEAF: Part = part!("bvh_leaf.wgsl");
-const BVH_STACK: Part = part!("bvh_stack.wgsl");
-const KEYS32: Part = part!("keys32.wgsl");
-const KEYS64: Part = part!("keys64.wgsl");
-const HASH: Part = part!("hash.wgsl");
-const BVH_PARENT_SIBLING: Part = part!("bvh_parent_sibling.wgsl");
-const BVH_REGISTER: Part = part!("bvh_register.wgsl");
-const FALLBACK_UNCLE: Part = part!("fallback_uncle.wgsl");
-const FALLBACK_HASH: Part = part!("fallback_hash.wgsl");
-const BVH_RUN: Part = part!("bvh_register_run.wgsl");
-const BVH_RESUME: Part = part!("bvh_resume.wgsl");
-const KD_COMMON: Part = part!("kd_common.wgsl");
-const KD_STACK: Part = part!("kd_stack.wgsl");
-const KD_RESTART: Part = part!("kd_restart.wgsl");
-const KD_PACKET: Part = part!("kd_packet.wgsl");
-const ENTRY: Part = part!("entry.wgsl");
+const PRELUDE: Part = part!(PRELUDE);
+const NUMERICS: Part = part!(NUMERICS);
+const BOX: Part = part!(BOX);
+const WATERTIGHT: Part = part!(TRIANGLE_WATERTIGHT);
+const MOLLER_TRUMBORE: Part = part!(TRIANGLE_MOLLER_TRUMBORE);
+const QUERY: Part = part!(QUERY);
+const RECORD: Part = part!(RECORD);
+const BVH_LEAF: Part = part!(BVH_LEAF);
+const BVH_STACK: Part = part!(BVH_STACK);
+const KEYS32: Part = part!(KEYS32);
+const KEYS64: Part = part!(KEYS64);
+const HASH: Part = part!(HASH);
+const BVH_PARENT_SIBLING: Part = part!(BVH_PARENT_SIBLING);
+const BVH_REGISTER: Part = part!(BVH_REGISTER);
+const FALLBACK_UNCLE: Part = part!(FALLBACK_UNCLE);
+const FALLBACK_HASH: Part = part!(FALLBACK_HASH);
+const BVH_RUN: Part = part!(BVH_REGISTER_RUN);
+const BVH_RESUME: Part = part!(BVH_RESUME);
+const KD_COMMON: Part = part!(KD_COMMON);
+const KD_STACK: Part = part!(KD_STACK);
+const KD_RESTART: Part = part!(KD_RESTART);
+const KD_PACKET: Part = part!(KD_PACKET);
+const ENTRY: Part = part!(ENTRY);
 
 /// Everything that selects a kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

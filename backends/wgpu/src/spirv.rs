@@ -143,8 +143,8 @@ mod tests {
     fn the_probe_kernel_gets_capability_extension_and_mode_in_their_sections() {
         let source = format!(
             "{}\n{}",
-            include_str!("../../../shaders/probe.wgsl"),
-            include_str!("../../../shaders/numerics.wgsl")
+            raytrail_shaders::PROBE.text,
+            raytrail_shaders::NUMERICS.text
         );
         let words = compile_preserving_subnormals(&source, &[]).expect("compiles");
         let ops: Vec<u16> = instructions(&words).iter().map(|i| split(i[0]).0).collect();

@@ -7,7 +7,8 @@ use raytrail::core::prepared::PreparedBvh2;
 use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
 use raytrail::core::traverse::{Method, Query};
 use raytrail::core::Hit;
-use raytrail::cpu::{npy, CpuBackend};
+use raytrail::cpu::CpuBackend;
+use raytrail_cli::npy;
 use raytrail::{load_scene, Builder};
 use std::sync::Arc;
 

@@ -17,7 +17,7 @@
 //! is an [`NpyError`] that names the file and what is wrong; nothing here panics on bad input, and
 //! no allocation is sized from the header before the data backing it has been read.
 
-use raytrail_core::{Hit, Ray};
+use raytrail::core::{Hit, Ray};
 use std::fmt;
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Read, Write};

@@ -1,0 +1,6 @@
+//! The library half of the `raytrail` command line: what its tests and other tools share with it.
+//!
+//! - [`npy`]: NumPy ray and hit files, the command line's exchange format.
+#![warn(missing_docs)]
+
+pub mod npy;

@@ -1,0 +1,107 @@
+//! raytrail's WGSL kernels as source text, one file per concern (README.md here says which files
+//! make which method's kernel). `raytrail-wgpu` composes them per method, key width, triangle test,
+//! query and recording; a tool that wants the plain sources (a linter, another WGSL host) reads
+//! them here.
+#![no_std]
+#![warn(missing_docs)]
+
+/// One WGSL file: its name in this folder and its text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Source {
+    /// File name, for example `box.wgsl`.
+    pub name: &'static str,
+    /// The file's text.
+    pub text: &'static str,
+}
+
+/// `box.wgsl`.
+pub const BOX: Source = Source { name: "box.wgsl", text: include_str!("box.wgsl") };
+
+/// `bvh_leaf.wgsl`.
+pub const BVH_LEAF: Source = Source { name: "bvh_leaf.wgsl", text: include_str!("bvh_leaf.wgsl") };
+
+/// `bvh_parent_sibling.wgsl`.
+pub const BVH_PARENT_SIBLING: Source = Source { name: "bvh_parent_sibling.wgsl", text: include_str!("bvh_parent_sibling.wgsl") };
+
+/// `bvh_register.wgsl`.
+pub const BVH_REGISTER: Source = Source { name: "bvh_register.wgsl", text: include_str!("bvh_register.wgsl") };
+
+/// `bvh_register_run.wgsl`.
+pub const BVH_REGISTER_RUN: Source = Source { name: "bvh_register_run.wgsl", text: include_str!("bvh_register_run.wgsl") };
+
+/// `bvh_resume.wgsl`.
+pub const BVH_RESUME: Source = Source { name: "bvh_resume.wgsl", text: include_str!("bvh_resume.wgsl") };
+
+/// `bvh_stack.wgsl`.
+pub const BVH_STACK: Source = Source { name: "bvh_stack.wgsl", text: include_str!("bvh_stack.wgsl") };
+
+/// `entry.wgsl`.
+pub const ENTRY: Source = Source { name: "entry.wgsl", text: include_str!("entry.wgsl") };
+
+/// `fallback_hash.wgsl`.
+pub const FALLBACK_HASH: Source = Source { name: "fallback_hash.wgsl", text: include_str!("fallback_hash.wgsl") };
+
+/// `fallback_uncle.wgsl`.
+pub const FALLBACK_UNCLE: Source = Source { name: "fallback_uncle.wgsl", text: include_str!("fallback_uncle.wgsl") };
+
+/// `hash.wgsl`.
+pub const HASH: Source = Source { name: "hash.wgsl", text: include_str!("hash.wgsl") };
+
+/// `kd_common.wgsl`.
+pub const KD_COMMON: Source = Source { name: "kd_common.wgsl", text: include_str!("kd_common.wgsl") };
+
+/// `kd_packet.wgsl`.
+pub const KD_PACKET: Source = Source { name: "kd_packet.wgsl", text: include_str!("kd_packet.wgsl") };
+
+/// `kd_restart.wgsl`.
+pub const KD_RESTART: Source = Source { name: "kd_restart.wgsl", text: include_str!("kd_restart.wgsl") };
+
+/// `kd_stack.wgsl`.
+pub const KD_STACK: Source = Source { name: "kd_stack.wgsl", text: include_str!("kd_stack.wgsl") };
+
+/// `keys32.wgsl`.
+pub const KEYS32: Source = Source { name: "keys32.wgsl", text: include_str!("keys32.wgsl") };
+
+/// `keys64.wgsl`.
+pub const KEYS64: Source = Source { name: "keys64.wgsl", text: include_str!("keys64.wgsl") };
+
+/// `numerics.wgsl`.
+pub const NUMERICS: Source = Source { name: "numerics.wgsl", text: include_str!("numerics.wgsl") };
+
+/// `prelude.wgsl`.
+pub const PRELUDE: Source = Source { name: "prelude.wgsl", text: include_str!("prelude.wgsl") };
+
+/// `probe.wgsl`.
+pub const PROBE: Source = Source { name: "probe.wgsl", text: include_str!("probe.wgsl") };
+
+/// `query.wgsl`.
+pub const QUERY: Source = Source { name: "query.wgsl", text: include_str!("query.wgsl") };
+
+/// `record.wgsl`.
+pub const RECORD: Source = Source { name: "record.wgsl", text: include_str!("record.wgsl") };
+
+/// `triangle_moller_trumbore.wgsl`.
+pub const TRIANGLE_MOLLER_TRUMBORE: Source = Source { name: "triangle_moller_trumbore.wgsl", text: include_str!("triangle_moller_trumbore.wgsl") };
+
+/// `triangle_watertight.wgsl`.
+pub const TRIANGLE_WATERTIGHT: Source = Source { name: "triangle_watertight.wgsl", text: include_str!("triangle_watertight.wgsl") };
+
+/// Every file, in name order.
+pub const ALL: &[Source] = &[BOX, BVH_LEAF, BVH_PARENT_SIBLING, BVH_REGISTER, BVH_REGISTER_RUN, BVH_RESUME, BVH_STACK, ENTRY, FALLBACK_HASH, FALLBACK_UNCLE, HASH, KD_COMMON, KD_PACKET, KD_RESTART, KD_STACK, KEYS32, KEYS64, NUMERICS, PRELUDE, PROBE, QUERY, RECORD, TRIANGLE_MOLLER_TRUMBORE, TRIANGLE_WATERTIGHT];
+
+/// The file of `name` (for example `"box.wgsl"`), if there is one.
+pub fn by_name(name: &str) -> Option<Source> {
+    ALL.iter().copied().find(|s| s.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_file_is_listed_once_and_found_by_name() {
+        for s in super::ALL {
+            assert!(!s.text.is_empty(), "{} is empty", s.name);
+            assert_eq!(super::by_name(s.name), Some(*s));
+        }
+        assert_eq!(super::by_name("missing.wgsl"), None);
+    }
+}
