@@ -7,9 +7,9 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use raytrail::conformance::paths::load_mesh_scene;
 use raytrail::conformance::rays::{diffuse, primary, RAY_SEED};
-use raytrail::core::prepared::PreparedBvh2;
+use raytrail::core::method::{Bvh2Method, KdMethod, Method};
+use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::{Trace, TraceOptions};
-use raytrail::core::traverse::Method;
 use raytrail::core::Hit;
 use raytrail::cpu::CpuBackend;
 use raytrail::Builder;
@@ -17,15 +17,15 @@ use std::sync::Arc;
 
 const SCENES: &[&str] = &["bunny.obj", "sponza.obj"];
 const METHODS: &[Method] = &[
-    Method::Stack,
-    Method::ParentSibling,
-    Method::Uncle,
-    Method::Hash,
-    Method::KdStack,
-    Method::KdRestart,
-    Method::KdPushDown,
-    Method::KdShortStack,
-    Method::KdPacket,
+    Method::Bvh2(Bvh2Method::Stack),
+    Method::Bvh2(Bvh2Method::ParentSibling),
+    Method::Bvh2(Bvh2Method::Uncle),
+    Method::Bvh2(Bvh2Method::Hash),
+    Method::Kd(KdMethod::Stack),
+    Method::Kd(KdMethod::Restart),
+    Method::Kd(KdMethod::PushDown),
+    Method::Kd(KdMethod::ShortStack),
+    Method::Kd(KdMethod::Packet),
 ];
 
 fn bench(c: &mut Criterion) {
@@ -36,11 +36,11 @@ fn bench(c: &mut Criterion) {
             Err(e) => panic!("{e} (the bench reads ../shared/scenes or RAYTRAIL_SCENES)"),
         };
         let bvh = Builder::Sah.build(&named.scene).expect("build");
-        let prepared = PreparedBvh2::new(&named.scene, bvh, METHODS).expect("prepare");
+        let prepared = PreparedScene::new(&named.scene, bvh, METHODS).expect("prepare");
         let scene = backend.prepare(Arc::new(prepared)).expect("prepare");
         let prim = primary(&named.scene, 256, 192);
         let mut hits = vec![Hit::MISS; prim.len()];
-        backend.trace(&scene, &prim, &TraceOptions::new(Method::Stack), &mut hits).expect("trace");
+        backend.trace(&scene, &prim, &TraceOptions::new(Method::Bvh2(Bvh2Method::Stack)), &mut hits).expect("trace");
         let bounce = diffuse(&prim, &hits, &named.scene, RAY_SEED);
         for (kind, rays) in [("primary", &prim), ("diffuse", &bounce)] {
             let mut group = c.benchmark_group(format!("{}/{kind}", named.name));

@@ -21,13 +21,15 @@ pub const BOX: Source = Source { name: "box.wgsl", text: include_str!("box.wgsl"
 pub const BVH_LEAF: Source = Source { name: "bvh_leaf.wgsl", text: include_str!("bvh_leaf.wgsl") };
 
 /// `bvh_parent_sibling.wgsl`.
-pub const BVH_PARENT_SIBLING: Source = Source { name: "bvh_parent_sibling.wgsl", text: include_str!("bvh_parent_sibling.wgsl") };
+pub const BVH_PARENT_SIBLING: Source =
+    Source { name: "bvh_parent_sibling.wgsl", text: include_str!("bvh_parent_sibling.wgsl") };
 
 /// `bvh_register.wgsl`.
 pub const BVH_REGISTER: Source = Source { name: "bvh_register.wgsl", text: include_str!("bvh_register.wgsl") };
 
 /// `bvh_register_run.wgsl`.
-pub const BVH_REGISTER_RUN: Source = Source { name: "bvh_register_run.wgsl", text: include_str!("bvh_register_run.wgsl") };
+pub const BVH_REGISTER_RUN: Source =
+    Source { name: "bvh_register_run.wgsl", text: include_str!("bvh_register_run.wgsl") };
 
 /// `bvh_resume.wgsl`.
 pub const BVH_RESUME: Source = Source { name: "bvh_resume.wgsl", text: include_str!("bvh_resume.wgsl") };
@@ -81,13 +83,40 @@ pub const QUERY: Source = Source { name: "query.wgsl", text: include_str!("query
 pub const RECORD: Source = Source { name: "record.wgsl", text: include_str!("record.wgsl") };
 
 /// `triangle_moller_trumbore.wgsl`.
-pub const TRIANGLE_MOLLER_TRUMBORE: Source = Source { name: "triangle_moller_trumbore.wgsl", text: include_str!("triangle_moller_trumbore.wgsl") };
+pub const TRIANGLE_MOLLER_TRUMBORE: Source =
+    Source { name: "triangle_moller_trumbore.wgsl", text: include_str!("triangle_moller_trumbore.wgsl") };
 
 /// `triangle_watertight.wgsl`.
-pub const TRIANGLE_WATERTIGHT: Source = Source { name: "triangle_watertight.wgsl", text: include_str!("triangle_watertight.wgsl") };
+pub const TRIANGLE_WATERTIGHT: Source =
+    Source { name: "triangle_watertight.wgsl", text: include_str!("triangle_watertight.wgsl") };
 
 /// Every file, in name order.
-pub const ALL: &[Source] = &[BOX, BVH_LEAF, BVH_PARENT_SIBLING, BVH_REGISTER, BVH_REGISTER_RUN, BVH_RESUME, BVH_STACK, ENTRY, FALLBACK_HASH, FALLBACK_UNCLE, HASH, KD_COMMON, KD_PACKET, KD_RESTART, KD_STACK, KEYS32, KEYS64, NUMERICS, PRELUDE, PROBE, QUERY, RECORD, TRIANGLE_MOLLER_TRUMBORE, TRIANGLE_WATERTIGHT];
+pub const ALL: &[Source] = &[
+    BOX,
+    BVH_LEAF,
+    BVH_PARENT_SIBLING,
+    BVH_REGISTER,
+    BVH_REGISTER_RUN,
+    BVH_RESUME,
+    BVH_STACK,
+    ENTRY,
+    FALLBACK_HASH,
+    FALLBACK_UNCLE,
+    HASH,
+    KD_COMMON,
+    KD_PACKET,
+    KD_RESTART,
+    KD_STACK,
+    KEYS32,
+    KEYS64,
+    NUMERICS,
+    PRELUDE,
+    PROBE,
+    QUERY,
+    RECORD,
+    TRIANGLE_MOLLER_TRUMBORE,
+    TRIANGLE_WATERTIGHT,
+];
 
 /// The file of `name` (for example `"box.wgsl"`), if there is one.
 pub fn by_name(name: &str) -> Option<Source> {

@@ -1,11 +1,41 @@
-//! raytrail: ray-traversal methods for triangle scenes.
+//! raytrail: ray-traversal methods for triangle scenes, checked against each other.
 //!
-//! This package gathers the crates and ships the `raytrail` command line:
+//! Load a mesh, build its tree, prepare it for the methods you will use, and trace:
+//!
+//! ```
+//! use raytrail::prelude::*;
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! // A mesh (here a triangle as OBJ text; `load_scene("file.obj")` reads a file).
+//! let mesh = raytrail::core::mesh::load_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "tri.obj")?;
+//! let scene = mesh.to_scene()?;
+//! // The canonical tree, and what the chosen method needs of it (here, the perfect hash).
+//! let bvh = Builder::Sah.build(&scene)?;
+//! let method = Method::Bvh2(Bvh2Method::Hash);
+//! let prepared = Arc::new(PreparedScene::new(&scene, bvh, &[method])?);
+//! // A backend prepares the scene once and traces batches of rays.
+//! let backend = CpuBackend::new();
+//! let cpu_scene = backend.prepare(prepared)?;
+//! let rays = [Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0), 0.0, f32::INFINITY)];
+//! let mut hits = [Hit::MISS];
+//! backend.trace(&cpu_scene, &rays, &TraceOptions::new(method), &mut hits)?;
+//! assert_eq!(hits[0].prim, 0);
+//! assert_eq!(hits[0].t, 1.0);
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! The crates behind it:
 //! - [`core`]: the `no_std` core (types, tests, keys, layouts, perfect hashing, state machines);
-//! - [`cpu`]: the rayon backend, the obvhs (PLOC) builder and NumPy files;
+//! - [`cpu`]: the rayon backend and the obvhs (PLOC) builder;
 //! - [`gpu`]: the wgpu backend (WGSL kernels mirroring the core's state machines);
-//! - [`conformance`]: the scenes, ray sets and cross-method checks.
+//! - [`conformance`]: the scenes, ray sets, checks and the suite every backend runs.
+//!
+//! The command line (`raytrail`, the bench and NumPy files) is the `raytrail-cli` package, so this
+//! library pulls in no bench dependency. docs/ARCHITECTURE.md tells how the parts fit.
 #![warn(missing_docs)]
+
+pub mod prelude;
 
 pub use raytrail_conformance as conformance;
 pub use raytrail_core as core;

@@ -2,9 +2,9 @@
 //! against the CPU ray by ray.
 
 use raytrail::conformance::check::{check_against, Context, Mismatch};
-use raytrail::core::prepared::PreparedBvh2;
-use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
-use raytrail::core::traverse::{Method, Query};
+use raytrail::core::method::{Method, Query};
+use raytrail::core::prepared::PreparedScene;
+use raytrail::core::trace::{Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::gpu::{WgpuBackend, WgpuScene};
@@ -18,7 +18,7 @@ pub struct Gpu {
 
 impl Gpu {
     /// Opens the adapter and uploads the scene, or says in one line why the GPU part is skipped.
-    pub fn open(prepared: Arc<PreparedBvh2>) -> Result<Gpu, String> {
+    pub fn open(prepared: Arc<PreparedScene>) -> Result<Gpu, String> {
         let backend = WgpuBackend::new().map_err(|e| e.to_string())?;
         let scene = backend.prepare(prepared).map_err(|e| e.to_string())?;
         Ok(Gpu { backend, scene })
@@ -40,7 +40,7 @@ impl Gpu {
 
     /// Median seconds of `passes` timed traces (after one untimed pass that compiles the kernel).
     pub fn time(&self, rays: &[Ray], method: Method, query: Query, passes: usize) -> Result<f64, String> {
-        let opts = TraceOptions { method, query, triangle_test: TriangleTestKind::Watertight, record: Record::Nothing };
+        let opts = TraceOptions::new(method).query(query);
         let mut hits = vec![Hit::MISS; rays.len()];
         self.backend.trace(&self.scene, rays, &opts, &mut hits).map_err(|e| e.to_string())?;
         let mut times = Vec::with_capacity(passes);

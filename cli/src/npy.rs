@@ -1,4 +1,4 @@
-//! NumPy `.npy` files of rays and hits, the CLI's exchange format (DESIGN.md, "Files in and out").
+//! NumPy `.npy` files of rays and hits, the CLI's exchange format (docs/ARCHITECTURE.md, "File formats").
 //!
 //! - Rays: a float32 array of shape `(N, 8)`, one row per ray: origin xyz, tmin, direction xyz,
 //!   tmax (the memory layout of [`Ray`]).

@@ -6,10 +6,10 @@ use crate::median::median;
 use crate::progress::{timed, Progress};
 use raytrail::conformance::check::{check_ray_set, Context, Mismatch};
 use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
+use raytrail::core::method::{Bvh2Method, KdMethod, Method, Query};
 use raytrail::core::observe::Counters;
-use raytrail::core::prepared::{BuiltHash, PreparedBvh2};
-use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
-use raytrail::core::traverse::{Method, Query};
+use raytrail::core::prepared::{BuiltHash, PreparedScene};
+use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::{load_scene, Builder, BUILTIN_SCENE};
@@ -58,7 +58,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         });
     let bvh = bvh.map_err(|e| e.to_string())?;
     let (prepared, _) =
-        timed("deriving layouts and hash tables for every method", || PreparedBvh2::new(scene, bvh, &Method::ALL));
+        timed("deriving layouts and hash tables for every method", || PreparedScene::new(scene, bvh, &Method::ALL));
     let prepared = Arc::new(prepared.map_err(|e| e.to_string())?);
     print_scene(&named.name, builder, build_s, &prepared);
 
@@ -79,12 +79,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     for set in &sets {
         let mut rows = Vec::new();
         for method in Method::ALL {
-            let mut opts = TraceOptions {
-                method,
-                query: set.query,
-                triangle_test: TriangleTestKind::Watertight,
-                record: Record::Nothing,
-            };
+            let mut opts = TraceOptions::new(method).query(set.query);
             let mut hits = vec![Hit::MISS; set.rays.len()];
             let mut times = Vec::with_capacity(passes);
             for _ in 0..passes {
@@ -152,7 +147,9 @@ fn ray_sets(
 ) -> Result<Vec<RaySetRun>, String> {
     let prim = primary(scene, w, h);
     let mut hits = vec![Hit::MISS; prim.len()];
-    backend.trace(cpu, &prim, &TraceOptions::new(Method::Stack), &mut hits).map_err(|e| e.to_string())?;
+    backend
+        .trace(cpu, &prim, &TraceOptions::new(Method::Bvh2(Bvh2Method::Stack)), &mut hits)
+        .map_err(|e| e.to_string())?;
     let bounds = scene.bounds();
     let shadow_rays = shadow(&prim, &hits, default_light(bounds), scene_epsilon(bounds));
     let diffuse_rays = diffuse(&prim, &hits, scene, RAY_SEED);
@@ -167,7 +164,7 @@ fn mb(bytes: usize) -> f64 {
     bytes as f64 / (1024.0 * 1024.0)
 }
 
-fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedBvh2) {
+fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedScene) {
     let s = p.bvh.stats();
     println!(
         "\nscene {name}: {} internal nodes, {} leaves (largest {}), depth {}, {} keys (the {} path)",
@@ -229,7 +226,7 @@ fn print_table(t: &SetResult<'_>, depth: u32, key_bytes: usize) {
         "  {:<15} {:>9} {:>10}{gpu_head} {:>10} {:>12} {:>10} {:>10} {:>8}  conformance",
         "method", "Mrays/s", "vs stack", "nodes/ray", "backtr./ray", "hash/ray", "links/ray", "state B"
     );
-    let stack_s = t.rows.iter().find(|r| r.0 == Method::Stack).map_or(0.0, |r| r.1);
+    let stack_s = t.rows.iter().find(|r| r.0 == Method::Bvh2(Bvh2Method::Stack)).map_or(0.0, |r| r.1);
     for (i, (m, secs, c)) in t.rows.iter().enumerate() {
         let mut bad = t.mismatches.iter().filter(|x| x.method == *m).count();
         let gpu_col = match &t.gpu {
@@ -266,7 +263,7 @@ fn print_kd(sets: &[(&str, Vec<Row>)]) {
     println!();
     for (name, rows) in sets {
         let get = |m: Method| rows.iter().find(|r| r.0 == m).map(|r| r.2);
-        let Some(base) = get(Method::KdStack) else { continue };
+        let Some(base) = get(Method::Kd(KdMethod::Stack)) else { continue };
         let base_inner = per_ray(base.internal_nodes, &base);
         print!("  {:<9}", name);
         for m in Method::KD {
@@ -288,7 +285,7 @@ fn print_backtracking(sets: &[(&str, Vec<Row>)]) {
         "rays", "postponed", "uncle", "g-uncle", "gg-uncle", "hash", "direct"
     );
     for (name, rows) in sets {
-        let Some((_, _, c)) = rows.iter().find(|r| r.0 == Method::Hash) else { continue };
+        let Some((_, _, c)) = rows.iter().find(|r| r.0 == Method::Bvh2(Bvh2Method::Hash)) else { continue };
         let total = c.backtracks.max(1) as f64;
         let pct = |x: u64| format!("{:.1}%", 100.0 * x as f64 / total);
         let levels: Vec<String> = c.levels.iter().map(|&l| format!("{:.0}", 100.0 * l as f64 / total)).collect();

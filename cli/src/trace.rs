@@ -3,13 +3,13 @@
 use crate::args::Args;
 use crate::progress::timed;
 use raytrail::conformance::rays::primary;
-use raytrail::core::prepared::PreparedBvh2;
-use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
-use raytrail::core::traverse::{Method, Query};
+use raytrail::core::method::{Method, Query};
+use raytrail::core::prepared::PreparedScene;
+use raytrail::core::trace::{Trace, TraceOptions, TriangleTestKind};
 use raytrail::core::Hit;
 use raytrail::cpu::CpuBackend;
-use raytrail_cli::npy;
 use raytrail::{load_scene, Builder};
+use raytrail_cli::npy;
 use std::sync::Arc;
 
 pub fn main(args: &[String]) -> Result<i32, String> {
@@ -26,19 +26,12 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     let rays = npy::read_rays(rays_path).map_err(|e| e.to_string())?;
     let (bvh, _) = timed("building the BVH2", || builder.build(&named.scene));
     let prepared =
-        PreparedBvh2::new(&named.scene, bvh.map_err(|e| e.to_string())?, &[method]).map_err(|e| e.to_string())?;
+        PreparedScene::new(&named.scene, bvh.map_err(|e| e.to_string())?, &[method]).map_err(|e| e.to_string())?;
     let backend = CpuBackend::new();
     let scene = backend.prepare(Arc::new(prepared)).map_err(|e| e.to_string())?;
-    let opts = TraceOptions {
-        method,
-        query: if a.has("any") { Query::Any } else { Query::Closest },
-        triangle_test: if a.has("moller-trumbore") {
-            TriangleTestKind::MollerTrumbore
-        } else {
-            TriangleTestKind::Watertight
-        },
-        record: Record::Nothing,
-    };
+    let opts = TraceOptions::new(method).query(if a.has("any") { Query::Any } else { Query::Closest }).triangle_test(
+        if a.has("moller-trumbore") { TriangleTestKind::MollerTrumbore } else { TriangleTestKind::Watertight },
+    );
     let mut hits = vec![Hit::MISS; rays.len()];
     let report = backend.trace(&scene, &rays, &opts, &mut hits).map_err(|e| e.to_string())?;
     npy::write_hits(out, &hits).map_err(|e| e.to_string())?;

@@ -2,13 +2,13 @@
 //! that match tracing the same rays through the library; bad input gives an error, not a panic.
 
 use raytrail::conformance::paths::mesh_path;
-use raytrail::core::prepared::PreparedBvh2;
+use raytrail::core::method::{Bvh2Method, Method};
+use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::{Trace, TraceOptions};
-use raytrail::core::traverse::Method;
 use raytrail::core::Hit;
 use raytrail::cpu::CpuBackend;
-use raytrail_cli::npy;
 use raytrail::{load_scene, Builder};
+use raytrail_cli::npy;
 use std::path::PathBuf;
 use std::process::Command;
 use std::sync::Arc;
@@ -56,11 +56,11 @@ fn rays_then_trace_matches_the_library() {
         assert_eq!(got.len(), 1200);
         let named = load_scene(scene.to_str().unwrap()).unwrap();
         let bvh = Builder::Sah.build(&named.scene).unwrap();
-        let prepared = PreparedBvh2::new(&named.scene, bvh, &[Method::Stack]).unwrap();
+        let prepared = PreparedScene::new(&named.scene, bvh, &[Method::Bvh2(Bvh2Method::Stack)]).unwrap();
         let backend = CpuBackend::new();
         let cpu = backend.prepare(Arc::new(prepared)).unwrap();
         let mut expected = vec![Hit::MISS; ray_list.len()];
-        backend.trace(&cpu, &ray_list, &TraceOptions::new(Method::Stack), &mut expected).unwrap();
+        backend.trace(&cpu, &ray_list, &TraceOptions::new(Method::Bvh2(Bvh2Method::Stack)), &mut expected).unwrap();
         assert!(got.iter().zip(&expected).all(|(a, b)| a.same_as(b)), "{method}: hits differ from the library's");
         assert!(got.iter().any(Hit::is_hit) && got.iter().any(|h| !h.is_hit()));
     }

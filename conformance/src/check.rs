@@ -1,7 +1,7 @@
 //! The conformance checks: every method against its reference, ray by ray.
 
-use raytrail_core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
-use raytrail_core::traverse::{Method, Query};
+use raytrail_core::method::{Bvh2Method, Method, Query};
+use raytrail_core::trace::{Record, Trace, TraceOptions};
 use raytrail_core::{Error, Hit, Ray};
 use std::fmt;
 
@@ -138,15 +138,12 @@ pub fn trace_all<B: Trace>(
     methods
         .iter()
         .map(|&method| {
-            let opts = TraceOptions {
-                method,
-                query,
-                triangle_test: TriangleTestKind::Watertight,
-                record: Record::Enumerations,
-            };
+            let opts = TraceOptions::new(method).query(query).record(Record::Enumerations);
             let mut hits = vec![Hit::MISS; rays.len()];
             let report = backend.trace(scene, rays, &opts, &mut hits)?;
-            Ok(Outcome { method, query, hits, enumerations: report.enumerations })
+            // A backend that recorded none is caught by `compare_backends`, which goes by the
+            // reference's enumerations.
+            Ok(Outcome { method, query, hits, enumerations: report.enumerations.unwrap_or_default() })
         })
         .collect()
 }
@@ -179,7 +176,9 @@ pub fn compare(ctx: Context<'_>, rays: &[Ray], outcomes: &[Outcome]) -> Vec<Mism
             ray: rays[i],
             difference,
         };
-        if let Some(stack) = find(Method::Stack, o.query).filter(|_| o.method != Method::Stack) {
+        if let Some(stack) =
+            find(Method::Bvh2(Bvh2Method::Stack), o.query).filter(|_| o.method != Method::Bvh2(Bvh2Method::Stack))
+        {
             for (i, (e, g)) in stack.hits.iter().zip(&o.hits).enumerate() {
                 let differs = match o.query {
                     Query::Closest => !e.same_as(g),
@@ -190,7 +189,7 @@ pub fn compare(ctx: Context<'_>, rays: &[Ray], outcomes: &[Outcome]) -> Vec<Mism
                         Query::Closest => Difference::Hit { expected: *e, got: *g },
                         Query::Any => Difference::Occlusion { expected: e.is_hit(), got: g.is_hit() },
                     };
-                    out.push(mismatch(i, Method::Stack, d));
+                    out.push(mismatch(i, Method::Bvh2(Bvh2Method::Stack), d));
                 }
             }
         }
@@ -269,7 +268,7 @@ pub fn check_against<R: Trace, B: Trace>(
     methods: &[Method],
 ) -> Result<Vec<Mismatch>, Error> {
     let mut all = Vec::new();
-    for query in [Query::Closest, Query::Any] {
+    for query in Query::ALL {
         let expected = trace_all(reference, reference_scene, rays, methods, query)?;
         let got = trace_all(backend, scene, rays, methods, query)?;
         all.extend(compare(ctx, rays, &got));
@@ -287,7 +286,7 @@ pub fn check_ray_set<B: Trace>(
     methods: &[Method],
 ) -> Result<Vec<Mismatch>, Error> {
     let mut all = Vec::new();
-    for query in [Query::Closest, Query::Any] {
+    for query in Query::ALL {
         let outcomes = trace_all(backend, scene, rays, methods, query)?;
         all.extend(compare(ctx, rays, &outcomes));
     }
@@ -302,7 +301,7 @@ mod tests {
     fn a_backend_that_recorded_no_enumerations_mismatches() {
         let rays = [Ray::new(glam::Vec3::ZERO, glam::Vec3::X, 0.0, 1.0)];
         let outcome = |enumerations: Vec<Vec<u32>>| Outcome {
-            method: Method::Hash,
+            method: Method::Bvh2(Bvh2Method::Hash),
             query: Query::Closest,
             hits: vec![Hit::MISS],
             enumerations,

@@ -5,29 +5,30 @@
 use raytrail_conformance::check::{check_ray_set, Context, Difference, Mismatch};
 use raytrail_conformance::rays::{primary, uniform_random, RAY_SEED};
 use raytrail_conformance::scenes::sphereflake;
+use raytrail_core::bvh2::traverse::trace_ray;
 use raytrail_core::bvh2::{BinaryNode, BvhMemory, LeafWord, NodeRef, SahBuilder, SliceMemory};
 use raytrail_core::hash::HashShape;
 use raytrail_core::intersect::Watertight;
+use raytrail_core::method::{Bvh2Method, Method, Query};
 use raytrail_core::observe::NoObserver;
-use raytrail_core::prepared::PreparedBvh2;
+use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::Trace;
-use raytrail_core::traverse::{trace_ray, Method, Query};
 use raytrail_core::Ray;
 use raytrail_cpu::CpuBackend;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::sync::Arc;
 
-fn setup() -> (PreparedBvh2, Vec<Ray>) {
+fn setup() -> (PreparedScene, Vec<Ray>) {
     let scene = sphereflake(2);
     let bvh = SahBuilder::default().build(scene.triangles()).unwrap();
-    let prepared = PreparedBvh2::new(&scene, bvh, &Method::ALL).unwrap();
+    let prepared = PreparedScene::new(&scene, bvh, &Method::ALL).unwrap();
     let mut rays = primary(&scene, 48, 48);
     rays.extend(uniform_random(&scene, 2000, RAY_SEED));
     (prepared, rays)
 }
 
-fn check(prepared: PreparedBvh2, rays: &[Ray]) -> Vec<Mismatch> {
+fn check(prepared: PreparedScene, rays: &[Ray]) -> Vec<Mismatch> {
     let backend = CpuBackend::new();
     let scene = backend.prepare(Arc::new(prepared)).unwrap();
     let ctx = Context { scene: "sphereflake(2), corrupted", ray_set: "primary+uniform", backend: "cpu" };
@@ -58,10 +59,19 @@ fn swapped_uncle_links_are_caught() {
     }
     let m = check(prepared, &rays);
     let caught = methods_caught(&m);
-    for method in [Method::Uncle, Method::Hash, Method::HashDisjoint, Method::HashResume] {
+    for method in [
+        Method::Bvh2(Bvh2Method::Uncle),
+        Method::Bvh2(Bvh2Method::Hash),
+        Method::Bvh2(Bvh2Method::HashDisjoint),
+        Method::Bvh2(Bvh2Method::HashResume),
+    ] {
         assert!(caught.contains(&method), "{method} not caught; caught {caught:?}");
     }
-    assert!(!caught.contains(&Method::Stack) && !caught.contains(&Method::ParentSibling), "{caught:?}");
+    assert!(
+        !caught.contains(&Method::Bvh2(Bvh2Method::Stack))
+            && !caught.contains(&Method::Bvh2(Bvh2Method::ParentSibling)),
+        "{caught:?}"
+    );
     let shown = m.iter().find(|x| matches!(x.difference, Difference::Enumeration { .. })).unwrap().to_string();
     assert!(shown.contains("enumerations part at position"), "{shown}");
     eprintln!("caught as expected, e.g.:\n{shown}");
@@ -98,12 +108,15 @@ impl BvhMemory for Tally<'_> {
 }
 
 /// The hash cell and the direct displacement entry the hash method reads most often.
-fn busiest(prepared: &PreparedBvh2, rays: &[Ray]) -> (u32, u32) {
-    let tally =
-        Tally { inner: prepared.memory(Method::Hash).unwrap(), cells: Default::default(), direct: Default::default() };
-    let root = prepared.root(Method::Hash).unwrap();
+fn busiest(prepared: &PreparedScene, rays: &[Ray]) -> (u32, u32) {
+    let tally = Tally {
+        inner: prepared.memory(Bvh2Method::Hash).unwrap(),
+        cells: Default::default(),
+        direct: Default::default(),
+    };
+    let root = prepared.root(Bvh2Method::Hash).unwrap();
     for r in rays {
-        trace_ray::<u32, _, Watertight, _>(Method::Hash, &tally, root, r, Query::Closest, &mut NoObserver);
+        trace_ray::<u32, _, Watertight, _>(Bvh2Method::Hash, &tally, root, r, Query::Closest, &mut NoObserver);
     }
     let top = |m: &RefCell<HashMap<u32, u32>>| *m.borrow().iter().max_by_key(|(k, v)| (**v, u32::MAX - **k)).unwrap().0;
     (top(&tally.cells), top(&tally.direct))
@@ -117,8 +130,11 @@ fn one_wrong_hash_cell_is_caught() {
     // Point the cell at the root: a plausible address, the wrong node.
     h.tables.cells[cell as usize] = NodeRef::internal(0).0;
     let caught = methods_caught(&check(prepared, &rays));
-    assert!(caught.contains(&Method::Hash) && caught.contains(&Method::HashDisjoint), "{caught:?}");
-    assert!(!caught.contains(&Method::Uncle), "{caught:?}");
+    assert!(
+        caught.contains(&Method::Bvh2(Bvh2Method::Hash)) && caught.contains(&Method::Bvh2(Bvh2Method::HashDisjoint)),
+        "{caught:?}"
+    );
+    assert!(!caught.contains(&Method::Bvh2(Bvh2Method::Uncle)), "{caught:?}");
 }
 
 #[test]
@@ -128,5 +144,5 @@ fn one_wrong_direct_displacement_is_caught() {
     let h = prepared.hash.as_mut().unwrap();
     h.tables.displacement[slot as usize] = raytrail_core::hash::encode_direct(NodeRef::internal(0));
     let caught = methods_caught(&check(prepared, &rays));
-    assert!(caught.contains(&Method::Hash), "{caught:?}");
+    assert!(caught.contains(&Method::Bvh2(Bvh2Method::Hash)), "{caught:?}");
 }

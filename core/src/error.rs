@@ -56,6 +56,14 @@ pub enum Error {
         /// What is missing.
         missing: &'static str,
     },
+    /// A method was handed to something that cannot run it: a traversal of another structure,
+    /// or a backend that does not implement it.
+    Unsupported {
+        /// The method.
+        method: &'static str,
+        /// What cannot run it.
+        by: &'static str,
+    },
     /// A backend's device failed or lacks something (no adapter, a missing feature, a limit).
     #[cfg(feature = "alloc")]
     Device {
@@ -88,6 +96,7 @@ impl fmt::Display for Error {
             Error::NotPrepared { method, missing } => {
                 write!(f, "method {method} needs {missing}, which the scene was not prepared with")
             }
+            Error::Unsupported { method, by } => write!(f, "method {method} is not supported by {by}"),
             #[cfg(feature = "alloc")]
             Error::Device { backend, detail } => write!(f, "{backend} backend: {detail}"),
         }

@@ -24,6 +24,7 @@ pub mod kd;
 pub mod key;
 #[cfg(feature = "std")]
 pub mod mesh;
+pub mod method;
 pub mod observe;
 #[cfg(feature = "alloc")]
 pub mod prepared;
@@ -35,3 +36,6 @@ pub mod traverse;
 
 pub use error::Error;
 pub use geometry::{Aabb, Hit, Ray};
+/// The vector library of the public API, re-exported so callers use the same version.
+pub use glam;
+pub use method::{Bvh2Method, KdMethod, Method, Query};

@@ -1,4 +1,4 @@
-//! Observers: what a traversal reports as it runs (DESIGN.md, "Traversal = state machine").
+//! Observers: what a traversal reports as it runs (docs/ARCHITECTURE.md, "Traversal: a state machine plus an observer").
 //!
 //! Every method calls the same hooks at the same points. [`NoObserver`] sets
 //! [`Observer::ENABLED`] to `false`; methods guard any work done only for an observer behind that

@@ -1,8 +1,8 @@
-//! The backend-agnostic trace API.
+//! The backend-agnostic trace API: what every backend implements and every caller uses.
 
+use crate::method::{Method, Query};
 use crate::observe::Counters;
-use crate::prepared::PreparedBvh2;
-use crate::traverse::{Method, Query};
+use crate::prepared::PreparedScene;
 use crate::{Error, Hit, Ray};
 use alloc::sync::Arc;
 use alloc::vec::Vec;
@@ -25,12 +25,21 @@ pub enum Record {
     Nothing,
     /// Work counters summed over the batch.
     Counters,
-    /// Counters and every ray's node enumeration (canonical node ids in visiting order).
+    /// Counters and every ray's node enumeration ([`PreparedScene::canonical_ids`]).
     Enumerations,
 }
 
-/// How to trace a batch.
+/// How to trace a batch. Built from a method and adjusted by the builder methods, so options can
+/// grow without breaking callers:
+///
+/// ```
+/// use raytrail_core::method::{Bvh2Method, Query};
+/// use raytrail_core::trace::{Record, TraceOptions};
+/// let options = TraceOptions::new(Bvh2Method::Hash).query(Query::Any).record(Record::Counters);
+/// assert_eq!(options.query, Query::Any);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub struct TraceOptions {
     /// Traversal method.
     pub method: Method,
@@ -44,25 +53,55 @@ pub struct TraceOptions {
 
 impl TraceOptions {
     /// Closest-hit tracing with `method`, watertight, recording nothing.
-    pub fn new(method: Method) -> Self {
-        Self { method, query: Query::Closest, triangle_test: TriangleTestKind::Watertight, record: Record::Nothing }
+    pub fn new(method: impl Into<Method>) -> Self {
+        Self {
+            method: method.into(),
+            query: Query::Closest,
+            triangle_test: TriangleTestKind::Watertight,
+            record: Record::Nothing,
+        }
+    }
+
+    /// The same options for `query`.
+    pub fn query(mut self, query: Query) -> Self {
+        self.query = query;
+        self
+    }
+
+    /// The same options with `test` as the triangle test.
+    pub fn triangle_test(mut self, test: TriangleTestKind) -> Self {
+        self.triangle_test = test;
+        self
+    }
+
+    /// The same options recording `record`.
+    pub fn record(mut self, record: Record) -> Self {
+        self.record = record;
+        self
     }
 }
 
-/// What a batch cost.
+/// What a batch cost, and what was recorded: a field is `None` exactly when it was not asked for.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub struct Report {
     /// Rays traced.
     pub rays: usize,
-    /// Wall-clock seconds of the traversal (0 where the backend has no clock).
+    /// Seconds of the traversal (0 where the backend has no clock); each backend documents
+    /// whether this is wall-clock or device time.
     pub seconds: f64,
-    /// Work counters, when recorded.
+    /// Work counters ([`Record::Counters`] and [`Record::Enumerations`]).
     pub counters: Option<Counters>,
-    /// Per-ray node enumerations (canonical ids), when recorded; empty otherwise.
-    pub enumerations: Vec<Vec<u32>>,
+    /// Per-ray node enumerations ([`Record::Enumerations`]).
+    pub enumerations: Option<Vec<Vec<u32>>>,
 }
 
 impl Report {
+    /// A report of `rays` rays traced in `seconds`, recording nothing.
+    pub fn new(rays: usize, seconds: f64) -> Self {
+        Self { rays, seconds, counters: None, enumerations: None }
+    }
+
     /// Millions of rays per second.
     pub fn mrays_per_s(&self) -> f64 {
         if self.seconds > 0.0 {
@@ -73,14 +112,28 @@ impl Report {
     }
 }
 
-/// A backend: prepares a scene once, then traces batches of rays into hit buffers.
-pub trait Trace {
+/// Fails with [`Error::BufferMismatch`] unless there is one hit slot per ray: the first check of
+/// every [`Trace::trace`].
+pub fn check_buffers(rays: &[Ray], hits: &[Hit]) -> Result<(), Error> {
+    if rays.len() == hits.len() {
+        Ok(())
+    } else {
+        Err(Error::BufferMismatch { rays: rays.len(), hits: hits.len() })
+    }
+}
+
+/// A backend: prepares a scene once, then traces batches of rays into hit buffers. Backends are
+/// shared across threads (`Send + Sync`); a scene prepared by one backend is traced by it alone.
+pub trait Trace: Send + Sync {
     /// The backend's own form of a scene (uploaded buffers, a shared reference, ...).
     type Prepared;
     /// Short name for reports.
     fn name(&self) -> &str;
+    /// Whether the backend can trace with `method`; [`Trace::trace`] fails with
+    /// [`Error::Unsupported`] for a method it cannot.
+    fn supports(&self, method: Method) -> bool;
     /// Makes a prepared scene usable by this backend.
-    fn prepare(&self, scene: Arc<PreparedBvh2>) -> Result<Self::Prepared, Error>;
+    fn prepare(&self, scene: Arc<PreparedScene>) -> Result<Self::Prepared, Error>;
     /// Traces `rays` into `hits` (same length), recording what `options` ask for.
     fn trace(
         &self,

@@ -5,10 +5,11 @@ use glam::Vec3;
 use raytrail_core::bvh2::NodeRef;
 use raytrail_core::geometry::Triangle;
 use raytrail_core::intersect::{TriangleTest, Watertight};
-use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, KdRoot, PACKET_WIDTH};
+use raytrail_core::kd::traverse::packets::packets;
+use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, KdRoot, RestartPolicy, PACKET_WIDTH};
 use raytrail_core::kd::{KdBuilder, KdSliceMemory};
+use raytrail_core::method::{KdMethod, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
-use raytrail_core::traverse::{Method, Query};
 use raytrail_core::{Hit, Ray};
 
 mod common;
@@ -101,18 +102,19 @@ fn check(tris: Vec<Triangle>, seed: u64) {
         for (i, ray) in rays.iter().enumerate() {
             let expected = brute(&tris, ray, any);
             let mut reference = Vec::new();
-            for (k, m) in
-                [Method::KdStack, Method::KdRestart, Method::KdPushDown, Method::KdShortStack].into_iter().enumerate()
-            {
+            // The packet method alone traces its ray as a packet of one.
+            for (k, m) in KdMethod::ALL.into_iter().enumerate() {
                 let mut o = Both(Counters::default(), Recorder::default());
                 let hit = trace_kd_ray::<_, Watertight, _>(m, &mem, &root, ray, query, &mut o);
-                inner[k] += o.0.internal_nodes;
+                if k < inner.len() {
+                    inner[k] += o.0.internal_nodes;
+                }
                 if any {
                     assert_eq!(hit.is_hit(), expected.is_hit(), "{m} ray {i}");
                 } else {
                     assert!(hit.same_as(&expected), "{m} ray {i}: {hit:?} vs brute force {expected:?}");
                 }
-                if m == Method::KdStack {
+                if m == KdMethod::Stack {
                     reference = leaves(&o.1);
                 } else {
                     assert_eq!(leaves(&o.1), reference, "{m} ray {i} leaves");
@@ -120,18 +122,18 @@ fn check(tris: Vec<Triangle>, seed: u64) {
             }
             stack_leaves.push(reference);
         }
-        // Packets of one octant, in ray order within each octant.
-        let octant = |r: &Ray| (0..3).fold(0, |acc, a| acc | ((r.dir[a].is_sign_negative() as usize) << a));
-        for oct in 0..8 {
-            let idx: Vec<usize> = (0..rays.len()).filter(|&i| octant(&rays[i]) == oct).collect();
-            for group in idx.chunks(PACKET_WIDTH) {
-                let packet: Vec<Ray> = group.iter().map(|&i| rays[i]).collect();
+        // Packets as every backend groups them.
+        {
+            for group in packets(&rays) {
+                let packet: Vec<Ray> = group.iter().map(|&i| rays[i as usize]).collect();
                 let mut hits = [Hit::MISS; PACKET_WIDTH];
                 let mut obs: [Recorder; PACKET_WIDTH] = Default::default();
+                let policy = RestartPolicy::short_stack(3);
                 trace_kd_packet::<PACKET_WIDTH, _, Watertight, _>(
-                    &mem, &root, &packet, any, 3, true, &mut hits, &mut obs,
+                    &mem, &root, &packet, query, policy, &mut hits, &mut obs,
                 );
                 for (k, &i) in group.iter().enumerate() {
+                    let i = i as usize;
                     let expected = brute(&tris, &rays[i], any);
                     if any {
                         assert_eq!(hits[k].is_hit(), expected.is_hit(), "packet ray {i}");

@@ -2,13 +2,14 @@
 //! conformance crate runs the full suite through the backends).
 
 use glam::Vec3;
+use raytrail_core::bvh2::traverse::trace_ray;
 use raytrail_core::bvh2::{SahBuilder, SahConfig};
 use raytrail_core::geometry::Triangle;
 use raytrail_core::intersect::Watertight;
+use raytrail_core::method::{Bvh2Method, Method, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
-use raytrail_core::prepared::PreparedBvh2;
+use raytrail_core::prepared::PreparedScene;
 use raytrail_core::scene::Scene;
-use raytrail_core::traverse::{trace_ray, Method, Query};
 use raytrail_core::Ray;
 
 mod common;
@@ -27,11 +28,11 @@ fn check_scene(tris: Vec<Triangle>, config: SahConfig, seed: u64) -> Counters {
 fn check_scene_with(tris: Vec<Triangle>, config: SahConfig, rays: &[Ray]) -> Counters {
     let scene = Scene::new(tris).unwrap();
     let bvh = SahBuilder::new(config).build(scene.triangles()).unwrap();
-    let prepared = PreparedBvh2::new(&scene, bvh, &Method::BVH2).unwrap();
+    let prepared = PreparedScene::new(&scene, bvh, &Method::BVH2).unwrap();
     let mut total = Counters::default();
     for query in [Query::Closest, Query::Any] {
         for (i, ray) in rays.iter().enumerate() {
-            let run = |m: Method| {
+            let run = |m: Bvh2Method| {
                 let mem = prepared.memory(m).unwrap();
                 let mut obs = Both(Counters::default(), Recorder::default());
                 let hit = match prepared.key_width() {
@@ -46,18 +47,18 @@ fn check_scene_with(tris: Vec<Triangle>, config: SahConfig, rays: &[Ray]) -> Cou
                 let ids: Vec<u32> = obs.1.nodes.iter().map(|&r| layout.canonical_id(r).unwrap()).collect();
                 (hit, ids, obs.0)
             };
-            let (stack_hit, stack_ids, _) = run(Method::Stack);
-            let (_, masked_ids, _) = run(Method::StackDisjoint);
-            for m in Method::BVH2 {
+            let (stack_hit, stack_ids, _) = run(Bvh2Method::Stack);
+            let (_, masked_ids, _) = run(Bvh2Method::StackDisjoint);
+            for m in Bvh2Method::ALL {
                 let (hit, ids, c) = run(m);
-                if m == Method::Hash {
+                if m == Bvh2Method::Hash {
                     total.add(&c);
                 }
                 match query {
                     Query::Closest => assert!(hit.same_as(&stack_hit), "{m} ray {i}: {hit:?} vs {stack_hit:?}"),
                     Query::Any => assert_eq!(hit.is_hit(), stack_hit.is_hit(), "{m} ray {i}"),
                 }
-                let reference = if m.reference() == Method::Stack { &stack_ids } else { &masked_ids };
+                let reference = if m.reference() == Bvh2Method::Stack { &stack_ids } else { &masked_ids };
                 assert_eq!(&ids, reference, "{m} ray {i} ({query:?}) enumeration");
             }
         }

@@ -7,8 +7,8 @@
 
 use raytrail_core::bvh2::{BinaryLayout, SahBuilder, SahConfig};
 use raytrail_core::hash::PerfectHash;
-use raytrail_core::prepared::PreparedBvh2;
-use raytrail_core::traverse::Method;
+use raytrail_core::method::{Bvh2Method, Method};
+use raytrail_core::prepared::PreparedScene;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -33,10 +33,10 @@ fn main() {
     assert!(stats.depth <= MAX_U32_DEPTH, "tree depth {} needs 64-bit keys; the example uses u32", stats.depth);
     // Every method: the stack methods and the stackless ones share the uncle layout; only
     // parent/sibling needs its own layout and only hash-resume the hash over every node.
-    let prepared = PreparedBvh2::new(&scene, bvh, &Method::BVH2).expect("the sphereflake prepares");
+    let prepared = PreparedScene::new(&scene, bvh, &Method::BVH2).expect("the sphereflake prepares");
 
-    let uncles = prepared.layout(Method::Uncle).expect("uncle layout prepared");
-    let parents = prepared.layout(Method::ParentSibling).expect("parent/sibling layout prepared");
+    let uncles = prepared.layout(Bvh2Method::Uncle).expect("uncle layout prepared");
+    let parents = prepared.layout(Bvh2Method::ParentSibling).expect("parent/sibling layout prepared");
     let hash = &prepared.hash.as_ref().expect("hash prepared").tables;
     let full_hash = &prepared.full_hash.as_ref().expect("full hash prepared").tables;
 
@@ -47,7 +47,7 @@ fn main() {
         write_hash(out, "full_hash", full_hash),
     ];
 
-    let root = prepared.root(Method::Stack).expect("root");
+    let root = prepared.root(Bvh2Method::Stack).expect("root");
     let bounds = prepared.bvh.nodes()[0].bounds;
     let mut rs = String::new();
     let w = &mut rs;
@@ -153,7 +153,7 @@ fn floats(w: &mut String, doc: &str, name: &str, v: [f32; 3]) {
 }
 
 /// The flash footprint, table by table, and the per-ray state of each method.
-fn footprint(p: &PreparedBvh2, uncles: &BinaryLayout, parents: &BinaryLayout, hash: &PerfectHash, full: &PerfectHash) {
+fn footprint(p: &PreparedScene, uncles: &BinaryLayout, parents: &BinaryLayout, hash: &PerfectHash, full: &PerfectHash) {
     let s = p.bvh.stats();
     let warn = |s: String| println!("cargo:warning={s}");
     warn(format!(

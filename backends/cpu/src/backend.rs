@@ -1,15 +1,17 @@
-use crate::dispatch::{trace_chunk, Chunk};
+use crate::chunk::Chunk;
 use rayon::prelude::*;
+use raytrail_core::kd::traverse::packets::PACKET_CHUNK;
+use raytrail_core::method::Method;
 use raytrail_core::observe::Counters;
-use raytrail_core::prepared::PreparedBvh2;
-use raytrail_core::trace::{Record, Report, Trace, TraceOptions};
-use raytrail_core::traverse::Family;
+use raytrail_core::prepared::PreparedScene;
+use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Rays per parallel task: large enough to amortize scheduling, small enough to balance load.
-const CHUNK: usize = 256;
+/// Rays per parallel task: large enough to amortize scheduling, small enough to balance load; the
+/// packet grouping's chunk, so that kd packets never span two tasks.
+const CHUNK: usize = PACKET_CHUNK;
 
 /// The rayon backend. Uses rayon's global pool unless built with a thread count.
 #[derive(Debug, Default)]
@@ -19,7 +21,7 @@ pub struct CpuBackend {
 
 /// A scene as the CPU backend holds it: shared, read in place.
 #[derive(Clone, Debug)]
-pub struct CpuScene(pub Arc<PreparedBvh2>);
+pub struct CpuScene(pub Arc<PreparedScene>);
 
 impl CpuBackend {
     /// A backend on rayon's global pool (all cores).
@@ -52,19 +54,22 @@ impl Trace for CpuBackend {
         "cpu"
     }
 
-    fn prepare(&self, scene: Arc<PreparedBvh2>) -> Result<CpuScene, Error> {
+    /// Every BVH2 and kd method.
+    fn supports(&self, method: Method) -> bool {
+        matches!(method, Method::Bvh2(_) | Method::Kd(_))
+    }
+
+    fn prepare(&self, scene: Arc<PreparedScene>) -> Result<CpuScene, Error> {
         Ok(CpuScene(scene))
     }
 
     fn trace(&self, scene: &CpuScene, rays: &[Ray], opts: &TraceOptions, hits: &mut [Hit]) -> Result<Report, Error> {
-        if rays.len() != hits.len() {
-            return Err(Error::BufferMismatch { rays: rays.len(), hits: hits.len() });
+        check_buffers(rays, hits)?;
+        if !self.supports(opts.method) {
+            return Err(Error::Unsupported { method: opts.method.name(), by: "the CPU backend" });
         }
         // Fail before timing if the scene lacks what the method needs.
-        match opts.method.family() {
-            Family::Bvh2 => scene.0.memory(opts.method).map(|_| ())?,
-            Family::Kd => scene.0.kd_memory().map(|_| ())?,
-        }
+        scene.0.check_prepared(opts.method)?;
         let mut enumerations: Vec<Vec<u32>> =
             if opts.record == Record::Enumerations { vec![Vec::new(); rays.len()] } else { Vec::new() };
         let start = Instant::now();
@@ -88,11 +93,18 @@ impl Trace for CpuBackend {
                 })
         })?;
         let seconds = start.elapsed().as_secs_f64();
-        Ok(Report {
-            rays: rays.len(),
-            seconds,
-            counters: (opts.record != Record::Nothing).then_some(counters),
-            enumerations,
-        })
+        let mut report = Report::new(rays.len(), seconds);
+        report.counters = (opts.record != Record::Nothing).then_some(counters);
+        report.enumerations = (opts.record == Record::Enumerations).then_some(enumerations);
+        Ok(report)
+    }
+}
+
+/// Traces one chunk with the loop of the method's structure.
+fn trace_chunk(scene: &PreparedScene, opts: &TraceOptions, chunk: Chunk<'_>) -> Result<Counters, Error> {
+    match opts.method {
+        Method::Bvh2(m) => crate::bvh2::trace_chunk(scene, m, opts, chunk),
+        Method::Kd(m) => crate::kd::trace_chunk(scene, m, opts, chunk),
+        other => Err(Error::Unsupported { method: other.name(), by: "the CPU backend" }),
     }
 }

@@ -9,8 +9,9 @@
 #![warn(missing_docs)]
 
 mod backend;
-mod dispatch;
-mod dispatch_kd;
+mod bvh2;
+mod chunk;
+mod kd;
 pub mod ploc;
 
 pub use backend::{CpuBackend, CpuScene};

@@ -3,16 +3,17 @@
 use crate::batch::{self, SceneBindings};
 use crate::compose::Variant;
 use crate::device::{device_error, Gpu, KernelForm};
-use crate::packets::packet_order;
 use crate::params::Params;
 use crate::pipelines::Pipelines;
 use crate::record;
 use crate::scene::WgpuScene;
 use raytrail_core::bvh2::NodeRef;
+use raytrail_core::kd::traverse::packets::{packet_slots, PADDING};
+use raytrail_core::kd::traverse::PACKET_WIDTH;
+use raytrail_core::method::{KdMethod, Method};
 use raytrail_core::observe::Counters;
-use raytrail_core::prepared::PreparedBvh2;
-use raytrail_core::trace::{Record, Report, Trace, TraceOptions};
-use raytrail_core::traverse::{Family, Method};
+use raytrail_core::prepared::PreparedScene;
+use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 use std::time::Instant;
@@ -27,8 +28,8 @@ const MAX_RECORD_CAP: usize = 1 << 24;
 /// Bytes of per-batch buffers (rays, hits, records) the backend aims to stay under.
 const BATCH_BYTES: usize = 256 << 20;
 
-/// Rays per packet of the kd-packet kernel.
-const PACKET: usize = 4;
+/// Rays per packet of the kd-packet kernel: the core's packet width.
+const PACKET: usize = PACKET_WIDTH;
 
 /// The wgpu backend: one device, kernels compiled on first use.
 pub struct WgpuBackend {
@@ -101,30 +102,29 @@ impl WgpuBackend {
             Record::Enumerations => record::stride(cap),
         };
         let mut params = Params { record_stride: stride as u32, record_cap: cap as u32, ..Params::default() };
-        let bindings = match options.method.family() {
-            Family::Bvh2 => {
-                let root = p.root(options.method)?;
-                let layout = scene
-                    .layout_for(options.method)
-                    .ok_or(Error::NotPrepared { method: options.method.name(), missing: "its BVH2 layout" })?;
+        let bindings = match options.method {
+            Method::Bvh2(m) => {
+                let root = p.root(m)?;
+                let layout =
+                    scene.layout_for(m).ok_or(Error::NotPrepared { method: m.name(), missing: "its BVH2 layout" })?;
                 params.root = root.node.0;
                 params.max_steps = root.max_steps;
                 params.scene_scale = root.scene_scale;
                 params.leaf_base = layout.leaf_base;
-                let hash = match scene.hash_for(options.method) {
+                let hash = match scene.hash_for(m) {
                     Some(h) => {
                         params.d_mask = h.d_mask;
                         params.h = h.h;
                         &h.buffer
                     }
-                    None if options.method.needs_hash() => {
-                        return Err(Error::NotPrepared { method: options.method.name(), missing: "the hash tables" })
+                    None if m.needs_hash() => {
+                        return Err(Error::NotPrepared { method: m.name(), missing: "the hash tables" })
                     }
                     None => &scene.empty,
                 };
                 SceneBindings { bvh: &layout.buffer, hash, kd: &scene.empty }
             }
-            Family::Kd => {
+            Method::Kd(_) => {
                 let root = p.kd_root()?;
                 let kd = scene.kd.as_ref().ok_or(Error::NotPrepared { method: "kd", missing: "the kd-tree" })?;
                 params.max_steps = root.max_steps;
@@ -136,15 +136,17 @@ impl WgpuBackend {
                 params.kd_hi = [root.hi.x, root.hi.y, root.hi.z, 0.0];
                 SceneBindings { bvh: &scene.empty, hash: &scene.empty, kd: &kd.buffer }
             }
+            other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
         };
-        // Packets hold rays of one direction octant: the batch is rearranged (and padded with
-        // untraceable rays) so that every four consecutive rays share one, then put back.
-        let order = (options.method == Method::KdPacket).then(|| packet_order(rays));
+        // Packets are grouped as the core says (every backend alike): the batch is rearranged into
+        // the grouping's slots, padding as untraceable rays, so that packet `p` is slots
+        // `PACKET * p ..`, then put back.
+        let order = (options.method == Method::Kd(KdMethod::Packet)).then(|| packet_slots(rays));
         let arranged: Vec<Ray>;
         let work: &[Ray] = match &order {
             Some(o) => {
                 let pad = Ray { origin: [f32::NAN; 3], tmin: 0.0, dir: [f32::NAN; 3], tmax: 0.0 };
-                arranged = o.iter().map(|&i| if i == u32::MAX { pad } else { rays[i as usize] }).collect();
+                arranged = o.iter().map(|&i| if i == PADDING { pad } else { rays[i as usize] }).collect();
                 &arranged
             }
             None => rays,
@@ -165,7 +167,7 @@ impl WgpuBackend {
             let mut h = vec![Hit::MISS; rays.len()];
             let mut r = vec![0u32; rays.len() * stride];
             for (slot, &i) in o.iter().enumerate() {
-                if i != u32::MAX {
+                if i != PADDING {
                     h[i as usize] = hits[slot];
                     let (dst, src) = (i as usize * stride, slot * stride);
                     r[dst..dst + stride].copy_from_slice(&records[src..src + stride]);
@@ -198,16 +200,9 @@ fn variant(scene: &WgpuScene, method: Method, options: &TraceOptions) -> Variant
     }
 }
 
-/// Canonical ids of one ray's recorded references: BVH2 nodes by the layout's numbering, kd
-/// leaves by index (the kd methods' enumerations are leaf sequences).
-fn enumeration(p: &PreparedBvh2, method: Method, refs: &[u32]) -> Result<Vec<u32>, Error> {
-    match method.family() {
-        Family::Bvh2 => {
-            let layout = p.layout(method)?;
-            Ok(refs.iter().map(|&r| layout.canonical_id(NodeRef(r)).unwrap_or(u32::MAX)).collect())
-        }
-        Family::Kd => Ok(refs.iter().map(|&r| NodeRef(r)).filter(|r| r.is_leaf()).map(|r| r.offset()).collect()),
-    }
+/// Canonical ids of one ray's recorded references, by the core's convention.
+fn enumeration(p: &PreparedScene, method: Method, refs: &[u32]) -> Result<Vec<u32>, Error> {
+    p.canonical_ids(method, refs.iter().map(|&r| NodeRef(r)))
 }
 
 impl Trace for WgpuBackend {
@@ -217,7 +212,12 @@ impl Trace for WgpuBackend {
         "wgpu"
     }
 
-    fn prepare(&self, scene: Arc<PreparedBvh2>) -> Result<WgpuScene, Error> {
+    /// Every BVH2 and kd method.
+    fn supports(&self, method: Method) -> bool {
+        matches!(method, Method::Bvh2(_) | Method::Kd(_))
+    }
+
+    fn prepare(&self, scene: Arc<PreparedScene>) -> Result<WgpuScene, Error> {
         WgpuScene::upload(&self.gpu, scene)
     }
 
@@ -228,15 +228,16 @@ impl Trace for WgpuBackend {
         options: &TraceOptions,
         hits: &mut [Hit],
     ) -> Result<Report, Error> {
-        if rays.len() != hits.len() {
-            return Err(Error::BufferMismatch { rays: rays.len(), hits: hits.len() });
+        check_buffers(rays, hits)?;
+        if !self.supports(options.method) {
+            return Err(Error::Unsupported { method: options.method.name(), by: "the wgpu backend" });
         }
         let start = Instant::now();
         let Traced { hits: out, records, stride, gpu_seconds } =
             self.trace_with_cap(scene, rays, options, DEFAULT_RECORD_CAP)?;
         let wall = start.elapsed().as_secs_f64();
         hits.copy_from_slice(&out);
-        let mut report = Report { rays: rays.len(), seconds: gpu_seconds.unwrap_or(wall), ..Report::default() };
+        let mut report = Report::new(rays.len(), gpu_seconds.unwrap_or(wall));
         if options.record == Record::Nothing {
             return Ok(report);
         }
@@ -285,7 +286,7 @@ impl Trace for WgpuBackend {
                 }
                 (overflowed, counts) = (still, still_counts);
             }
-            report.enumerations = enumerations;
+            report.enumerations = Some(enumerations);
         }
         Ok(report)
     }

@@ -9,8 +9,9 @@
 use raytrail_core::intersect::{FAR_PAD, RELIABLE_LIMIT, SLACK_SCALE};
 use raytrail_core::kd::traverse::{PACKET_WIDTH, SHORT_STACK_MAX};
 use raytrail_core::key::KeyWidth;
+use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query};
 use raytrail_core::trace::{Record, TriangleTestKind};
-use raytrail_core::traverse::{Method, Query};
+use raytrail_core::Error;
 
 /// One WGSL file of `raytrail-shaders`, by name and text.
 type Part = (&'static str, &'static str);
@@ -76,8 +77,8 @@ impl Variant {
         )
     }
 
-    /// The WGSL files of this kernel, in order.
-    pub fn parts(&self) -> Vec<Part> {
+    /// The WGSL files of this kernel, in order; [`Error::Unsupported`] for a method without one.
+    pub fn parts(&self) -> Result<Vec<Part>, Error> {
         let triangle = match self.triangle {
             TriangleTestKind::Watertight => WATERTIGHT,
             TriangleTestKind::MollerTrumbore => MOLLER_TRUMBORE,
@@ -85,31 +86,36 @@ impl Variant {
         let keys = if self.keys == KeyWidth::W64 { KEYS64 } else { KEYS32 };
         let mut parts = vec![PRELUDE, NUMERICS, BOX, triangle, QUERY, RECORD];
         let method: &[Part] = match self.method {
-            Method::Stack | Method::StackDisjoint => &[BVH_LEAF, BVH_STACK],
-            Method::ParentSibling => &[BVH_LEAF, keys, BVH_PARENT_SIBLING],
-            Method::Uncle => &[BVH_LEAF, keys, FALLBACK_UNCLE, BVH_REGISTER, BVH_RUN],
-            Method::Hash | Method::HashDisjoint => &[BVH_LEAF, keys, HASH, FALLBACK_HASH, BVH_REGISTER, BVH_RUN],
-            Method::HashResume => &[BVH_LEAF, keys, HASH, FALLBACK_HASH, BVH_REGISTER, BVH_RESUME],
-            Method::KdStack => &[KD_COMMON, KD_STACK],
-            Method::KdRestart | Method::KdPushDown | Method::KdShortStack => &[KD_COMMON, KD_RESTART],
-            Method::KdPacket => &[KD_COMMON, KD_PACKET],
+            Method::Bvh2(Bvh2Method::Stack) | Method::Bvh2(Bvh2Method::StackDisjoint) => &[BVH_LEAF, BVH_STACK],
+            Method::Bvh2(Bvh2Method::ParentSibling) => &[BVH_LEAF, keys, BVH_PARENT_SIBLING],
+            Method::Bvh2(Bvh2Method::Uncle) => &[BVH_LEAF, keys, FALLBACK_UNCLE, BVH_REGISTER, BVH_RUN],
+            Method::Bvh2(Bvh2Method::Hash) | Method::Bvh2(Bvh2Method::HashDisjoint) => {
+                &[BVH_LEAF, keys, HASH, FALLBACK_HASH, BVH_REGISTER, BVH_RUN]
+            }
+            Method::Bvh2(Bvh2Method::HashResume) => &[BVH_LEAF, keys, HASH, FALLBACK_HASH, BVH_REGISTER, BVH_RESUME],
+            Method::Kd(KdMethod::Stack) => &[KD_COMMON, KD_STACK],
+            Method::Kd(KdMethod::Restart) | Method::Kd(KdMethod::PushDown) | Method::Kd(KdMethod::ShortStack) => {
+                &[KD_COMMON, KD_RESTART]
+            }
+            Method::Kd(KdMethod::Packet) => &[KD_COMMON, KD_PACKET],
+            other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
         };
         parts.extend_from_slice(method);
         // A packet kernel has its own entry point: one invocation per packet of rays.
-        if self.method != Method::KdPacket {
+        if self.method != Method::Kd(KdMethod::Packet) {
             parts.push(ENTRY);
         }
-        parts
+        Ok(parts)
     }
 
     /// The full WGSL source: the generated constants, then the parts.
-    pub fn source(&self) -> String {
+    pub fn source(&self) -> Result<String, Error> {
         let mut s = constants_header(self.method);
-        for (name, text) in self.parts() {
+        for (name, text) in self.parts()? {
             s.push_str(&format!("\n// ---- shaders/{name} ----\n"));
             s.push_str(text);
         }
-        s
+        Ok(s)
     }
 
     /// Values of the override constants.
@@ -119,7 +125,8 @@ impl Variant {
             Record::Counters => 1.0,
             Record::Enumerations => 2.0,
         };
-        let disjoint = matches!(self.method, Method::StackDisjoint | Method::HashDisjoint);
+        let disjoint =
+            matches!(self.method, Method::Bvh2(Bvh2Method::StackDisjoint) | Method::Bvh2(Bvh2Method::HashDisjoint));
         vec![
             ("ANY_HIT", f64::from(u8::from(self.query == Query::Any))),
             ("RECORD", record),
@@ -132,8 +139,8 @@ impl Variant {
 /// values rather than retyped as WGSL literals (which a compiler would round its own way).
 fn constants_header(method: Method) -> String {
     let kd_mode = match method {
-        Method::KdRestart => 0,
-        Method::KdPushDown => 1,
+        Method::Kd(KdMethod::Restart) => 0,
+        Method::Kd(KdMethod::PushDown) => 1,
         _ => 2,
     };
     format!(
@@ -174,7 +181,7 @@ mod tests {
 
     /// naga as wgpu runs it: parse, then validate with the capabilities the backend requests.
     fn validate(v: &Variant) -> Result<(), String> {
-        let src = v.source();
+        let src = v.source().expect("every method has a kernel");
         let module = naga::front::wgsl::parse_str(&src).map_err(|e| e.emit_to_string(&src))?;
         let caps = naga::valid::Capabilities::FLOAT64;
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
@@ -206,7 +213,7 @@ mod tests {
 
     #[test]
     fn constants_are_the_cores_bits() {
-        let h = constants_header(Method::Stack);
+        let h = constants_header(Method::Bvh2(Bvh2Method::Stack));
         assert!(h.contains(&format!("{:#010x}", FAR_PAD.to_bits())));
         assert!(h.contains(&format!("{:#010x}", SLACK_SCALE.to_bits())));
         assert_eq!(SLACK_SCALE.to_bits(), (1.0f32 / 524288.0).to_bits());

@@ -17,7 +17,6 @@ pub mod compose;
 mod device;
 mod float_controls;
 mod kernel;
-mod packets;
 mod params;
 mod pipelines;
 mod probe;

@@ -66,7 +66,7 @@ impl Pipelines {
             return Ok(p.clone());
         }
         let label = v.label();
-        let pipeline = gpu.compute_pipeline(&label, &v.source(), &v.overrides(), &self.layout)?;
+        let pipeline = gpu.compute_pipeline(&label, &v.source()?, &v.overrides(), &self.layout)?;
         let pipeline = Arc::new(pipeline);
         self.compiled.lock().map_err(|_| poisoned())?.insert(*v, pipeline.clone());
         Ok(pipeline)

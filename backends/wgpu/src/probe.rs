@@ -79,8 +79,7 @@ fn samples(n: usize) -> Vec<[u32; 4]> {
 
 /// Runs the probe on `gpu`.
 pub(crate) fn probe(gpu: &Gpu, n: usize) -> Result<NumericsProbe, Error> {
-    let source =
-        format!("{}\n{}", raytrail_shaders::PROBE.text, raytrail_shaders::NUMERICS.text);
+    let source = format!("{}\n{}", raytrail_shaders::PROBE.text, raytrail_shaders::NUMERICS.text);
     let input = samples(n);
     let d = &gpu.device;
     let out: Vec<[u32; 4]> = gpu.checked("running the numerics probe", || -> Result<Vec<[u32; 4]>, Error> {

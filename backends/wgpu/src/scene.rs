@@ -3,8 +3,8 @@
 
 use crate::device::{device_error, Gpu};
 use raytrail_core::bvh2::BinaryLayout;
-use raytrail_core::prepared::{BuiltHash, PreparedBvh2};
-use raytrail_core::traverse::Method;
+use raytrail_core::method::Bvh2Method;
+use raytrail_core::prepared::{BuiltHash, PreparedScene};
 use raytrail_core::Error;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -33,7 +33,7 @@ pub(crate) struct KdBuffer {
 /// A scene as the wgpu backend holds it.
 pub struct WgpuScene {
     /// The prepared scene (the host side: roots, layouts for canonical ids, key width).
-    pub prepared: Arc<PreparedBvh2>,
+    pub prepared: Arc<PreparedScene>,
     pub(crate) uncles: Option<LayoutBuffer>,
     pub(crate) parents: Option<LayoutBuffer>,
     pub(crate) hash: Option<HashBuffer>,
@@ -87,7 +87,7 @@ fn hash(gpu: &Gpu, label: &str, h: &BuiltHash) -> Result<HashBuffer, Error> {
 
 impl WgpuScene {
     /// Uploads what `prepared` holds.
-    pub(crate) fn upload(gpu: &Gpu, prepared: Arc<PreparedBvh2>) -> Result<WgpuScene, Error> {
+    pub(crate) fn upload(gpu: &Gpu, prepared: Arc<PreparedScene>) -> Result<WgpuScene, Error> {
         let p = &prepared;
         let uncles = p.uncles.as_ref().map(|l| layout(gpu, "uncle layout", l)).transpose()?;
         let parents = p.parents.as_ref().map(|l| layout(gpu, "parent/sibling layout", l)).transpose()?;
@@ -115,7 +115,7 @@ impl WgpuScene {
     }
 
     /// The layout buffer `method` reads.
-    pub(crate) fn layout_for(&self, method: Method) -> Option<&LayoutBuffer> {
+    pub(crate) fn layout_for(&self, method: Bvh2Method) -> Option<&LayoutBuffer> {
         if method.needs_parent_links() {
             self.parents.as_ref()
         } else {
@@ -124,7 +124,7 @@ impl WgpuScene {
     }
 
     /// The hash buffer `method` reads, if any.
-    pub(crate) fn hash_for(&self, method: Method) -> Option<&HashBuffer> {
+    pub(crate) fn hash_for(&self, method: Bvh2Method) -> Option<&HashBuffer> {
         if method.needs_full_hash() {
             self.full_hash.as_ref()
         } else if method.needs_hash() {

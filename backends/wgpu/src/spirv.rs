@@ -141,11 +141,7 @@ mod tests {
 
     #[test]
     fn the_probe_kernel_gets_capability_extension_and_mode_in_their_sections() {
-        let source = format!(
-            "{}\n{}",
-            raytrail_shaders::PROBE.text,
-            raytrail_shaders::NUMERICS.text
-        );
+        let source = format!("{}\n{}", raytrail_shaders::PROBE.text, raytrail_shaders::NUMERICS.text);
         let words = compile_preserving_subnormals(&source, &[]).expect("compiles");
         let ops: Vec<u16> = instructions(&words).iter().map(|i| split(i[0]).0).collect();
         let caps = ops.iter().take_while(|&&op| op == OP_CAPABILITY).count();

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 use raytrail::core::geometry::Triangle;
-use raytrail::core::traverse::Query;
+use raytrail::core::method::Query;
 use raytrail::core::{Hit, Ray};
 use std::collections::BTreeMap;
 

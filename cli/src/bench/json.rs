@@ -1,146 +1,260 @@
-//! The run as JSON, written by hand (no serde): one object per scene, per ray type, per row.
+//! The run as JSON, through serde: one object per scene, per ray type, per row.
 //!
 //! Shape: `{command, baseline, passes, threads, scenes: [{name, triangles, width, height,
 //! builds: [{what, seconds, bytes: {part: n}}], rays: [{type, query, rays, rows: [{target, kind,
 //! threads, mrays_per_s, ratio, median_s, passes_s, nodes_per_ray, leaves_per_ray,
 //! tests_per_ray}], agreement: [{target, rays, exact, within_tolerance, classes: {class: n}}]}]}]}`.
-//! Figures not measured are `null`.
+//! Figures not measured, and NaN or infinite ones (which JSON lacks), are `null`.
+//!
+//! The report types stay free of serde; the private views below borrow them and fix the field
+//! names and order of the document.
 
+use super::agreement::{Agreement, Class};
 use super::report::{BenchReport, Built, RayReport, Row, SceneReport};
+use serde::{Serialize, Serializer};
+use std::collections::BTreeMap;
 
-/// The whole report as a JSON document.
+/// The whole report as a JSON document (indented, ending in a newline).
 pub fn to_json(r: &BenchReport) -> String {
-    let scenes: Vec<String> = r.scenes.iter().map(scene).collect();
-    let threads: Vec<String> = r.threads.iter().map(|t| t.to_string()).collect();
-    format!(
-        "{{\n\"command\": {},\n\"baseline\": {},\n\"passes\": {},\n\"threads\": [{}],\n\"scenes\": [\n{}\n]\n}}\n",
-        string(&r.command),
-        string(&r.baseline),
-        r.passes,
-        threads.join(", "),
-        scenes.join(",\n")
-    )
+    let doc = Doc {
+        command: &r.command,
+        baseline: &r.baseline,
+        passes: r.passes,
+        threads: &r.threads,
+        scenes: r.scenes.iter().map(Scene::from).collect(),
+    };
+    // Serializing these plain structs (string keys, no failing `Serialize` impls) cannot fail.
+    let mut out = serde_json::to_string_pretty(&doc).expect("the bench report serializes to JSON");
+    out.push('\n');
+    out
 }
 
-/// One scene.
-fn scene(s: &SceneReport) -> String {
-    let builds: Vec<String> = s.builds.iter().map(built).collect();
-    let rays: Vec<String> = s.rays.iter().map(ray_report).collect();
-    format!(
-        "{{\"name\": {}, \"triangles\": {}, \"width\": {}, \"height\": {},\n \"builds\": [\n  {}\n ],\n \"rays\": [\n{}\n ]}}",
-        string(&s.name),
-        s.triangles,
-        s.width,
-        s.height,
-        builds.join(",\n  "),
-        rays.join(",\n")
-    )
+#[derive(Serialize)]
+struct Doc<'a> {
+    command: &'a str,
+    baseline: &'a str,
+    passes: usize,
+    threads: &'a [usize],
+    scenes: Vec<Scene<'a>>,
 }
 
-/// One build step.
-fn built(b: &Built) -> String {
-    let bytes: Vec<String> = b.bytes.iter().map(|(k, n)| format!("{}: {n}", string(k))).collect();
-    format!(
-        "{{\"what\": {}, \"seconds\": {}, \"bytes\": {{{}}}}}",
-        string(&b.what),
-        number(b.seconds),
-        bytes.join(", ")
-    )
+#[derive(Serialize)]
+struct Scene<'a> {
+    name: &'a str,
+    triangles: usize,
+    width: u32,
+    height: u32,
+    builds: Vec<Build<'a>>,
+    rays: Vec<Rays<'a>>,
 }
 
-/// One ray type.
-fn ray_report(r: &RayReport) -> String {
-    let rows: Vec<String> = r.rows.iter().map(row).collect();
-    let agreement: Vec<String> = r
-        .agreement
-        .iter()
-        .map(|(target, a)| {
-            let classes: Vec<String> = a.classes.iter().map(|(c, n)| format!("{}: {n}", string(c.name()))).collect();
-            format!(
-                "{{\"target\": {}, \"rays\": {}, \"exact\": {}, \"within_tolerance\": {}, \"classes\": {{{}}}}}",
-                string(target),
-                a.rays,
-                a.exact,
-                a.close,
-                classes.join(", ")
-            )
-        })
-        .collect();
-    format!(
-        "  {{\"type\": {}, \"query\": {}, \"rays\": {},\n   \"rows\": [\n    {}\n   ],\n   \"agreement\": [\n    {}\n   ]}}",
-        string(r.kind.name()),
-        string(r.kind.query().name()),
-        r.rays,
-        rows.join(",\n    "),
-        agreement.join(",\n    ")
-    )
-}
-
-/// One row.
-fn row(r: &Row) -> String {
-    let passes: Vec<String> = r.passes.iter().map(|&s| number(s)).collect();
-    let w = r.work.unwrap_or_default();
-    let opt = |x: Option<f64>| x.map_or("null".to_string(), number);
-    format!(
-        "{{\"target\": {}, \"kind\": {}, \"threads\": {}, \"mrays_per_s\": {}, \"ratio\": {}, \"median_s\": {}, \"passes_s\": [{}], \"nodes_per_ray\": {}, \"leaves_per_ray\": {}, \"tests_per_ray\": {}}}",
-        string(&r.target),
-        string(r.kind.name()),
-        r.threads,
-        number(r.mrays_per_s),
-        opt(r.ratio),
-        number(r.median_s),
-        passes.join(", "),
-        opt(w.nodes),
-        opt(w.leaves),
-        opt(w.tests)
-    )
-}
-
-/// A JSON number; `null` for NaN and infinities, which JSON lacks.
-fn number(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        "null".to_string()
-    }
-}
-
-/// A JSON string literal: quotes, backslashes and control characters escaped.
-pub fn string(s: &str) -> String {
-    let mut out = String::with_capacity(s.len() + 2);
-    out.push('"');
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            '\r' => out.push_str("\\r"),
-            '\t' => out.push_str("\\t"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
-            c => out.push(c),
+impl<'a> From<&'a SceneReport> for Scene<'a> {
+    fn from(s: &'a SceneReport) -> Self {
+        Scene {
+            name: &s.name,
+            triangles: s.triangles,
+            width: s.width,
+            height: s.height,
+            builds: s.builds.iter().map(Build::from).collect(),
+            rays: s.rays.iter().map(Rays::from).collect(),
         }
     }
-    out.push('"');
-    out
+}
+
+#[derive(Serialize)]
+struct Build<'a> {
+    what: &'a str,
+    seconds: f64,
+    /// Part name to bytes, in the report's order.
+    #[serde(serialize_with = "pairs_as_map")]
+    bytes: &'a [(String, usize)],
+}
+
+impl<'a> From<&'a Built> for Build<'a> {
+    fn from(b: &'a Built) -> Self {
+        Build { what: &b.what, seconds: b.seconds, bytes: &b.bytes }
+    }
+}
+
+#[derive(Serialize)]
+struct Rays<'a> {
+    #[serde(rename = "type")]
+    kind: &'static str,
+    query: &'static str,
+    rays: usize,
+    rows: Vec<RowView<'a>>,
+    agreement: Vec<AgreementView<'a>>,
+}
+
+impl<'a> From<&'a RayReport> for Rays<'a> {
+    fn from(r: &'a RayReport) -> Self {
+        Rays {
+            kind: r.kind.name(),
+            query: r.kind.query().name(),
+            rays: r.rays,
+            rows: r.rows.iter().map(RowView::from).collect(),
+            agreement: r.agreement.iter().map(|(target, a)| AgreementView::new(target, a)).collect(),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct RowView<'a> {
+    target: &'a str,
+    kind: &'static str,
+    threads: usize,
+    mrays_per_s: f64,
+    ratio: Option<f64>,
+    median_s: f64,
+    passes_s: &'a [f64],
+    nodes_per_ray: Option<f64>,
+    leaves_per_ray: Option<f64>,
+    tests_per_ray: Option<f64>,
+}
+
+impl<'a> From<&'a Row> for RowView<'a> {
+    fn from(r: &'a Row) -> Self {
+        let w = r.work.unwrap_or_default();
+        RowView {
+            target: &r.target,
+            kind: r.kind.name(),
+            threads: r.threads,
+            mrays_per_s: r.mrays_per_s,
+            ratio: r.ratio,
+            median_s: r.median_s,
+            passes_s: &r.passes,
+            nodes_per_ray: w.nodes,
+            leaves_per_ray: w.leaves,
+            tests_per_ray: w.tests,
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct AgreementView<'a> {
+    target: &'a str,
+    rays: usize,
+    exact: usize,
+    within_tolerance: usize,
+    /// Class name to rays, in the classes' order.
+    #[serde(serialize_with = "classes_as_map")]
+    classes: &'a BTreeMap<Class, usize>,
+}
+
+impl<'a> AgreementView<'a> {
+    fn new(target: &'a str, a: &'a Agreement) -> Self {
+        AgreementView { target, rays: a.rays, exact: a.exact, within_tolerance: a.close, classes: &a.classes }
+    }
+}
+
+/// `[(key, n)]` as a JSON object, keeping the order.
+fn pairs_as_map<S: Serializer>(pairs: &&[(String, usize)], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_map(pairs.iter().map(|(k, n)| (k, n)))
+}
+
+/// Classes as a JSON object keyed by their report names.
+fn classes_as_map<S: Serializer>(classes: &&BTreeMap<Class, usize>, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_map(classes.iter().map(|(c, n)| (c.name(), n)))
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::rays::RayKind;
+    use super::super::target::{TargetKind, Work};
     use super::*;
+    use serde_json::{json, Value};
 
-    #[test]
-    fn strings_are_escaped() {
-        assert_eq!(string("plain"), "\"plain\"");
-        assert_eq!(string("a \"b\" \\ c"), "\"a \\\"b\\\" \\\\ c\"");
-        assert_eq!(string("line\nnext\ttab\u{1}"), "\"line\\nnext\\ttab\\u0001\"");
-        assert_eq!(string("dragon_vrip.ply.gz — ü"), "\"dragon_vrip.ply.gz — ü\"");
+    fn report() -> BenchReport {
+        let row = |target: &str, kind, ratio, work| Row {
+            target: target.into(),
+            kind,
+            threads: 4,
+            passes: vec![0.5, 0.25, f64::NAN],
+            median_s: 0.25,
+            mrays_per_s: 3.0,
+            ratio,
+            work,
+        };
+        let agreement = Agreement {
+            rays: 10,
+            exact: 7,
+            close: 8,
+            classes: BTreeMap::from([(Class::NearTie, 1), (Class::TieEqualT, 1)]),
+        };
+        BenchReport {
+            command: "raytrail bench --scene \"a b\\c\".ply\n".into(),
+            baseline: "stack".into(),
+            passes: 3,
+            threads: vec![1, 4],
+            scenes: vec![SceneReport {
+                name: "dragon_vrip.ply.gz — ü".into(),
+                triangles: 12,
+                width: 64,
+                height: 48,
+                builds: vec![Built {
+                    what: "raytrail sah".into(),
+                    seconds: 1.5,
+                    bytes: vec![("nodes".into(), 1024), ("indices".into(), 48)],
+                }],
+                rays: vec![RayReport {
+                    kind: RayKind::Shadow,
+                    rays: 10,
+                    rows: vec![
+                        row(
+                            "stack",
+                            TargetKind::RaytrailBvh2,
+                            Some(1.0),
+                            Some(Work { nodes: Some(12.5), leaves: None, tests: Some(f64::INFINITY) }),
+                        ),
+                        row("obvhs", TargetKind::PeerOwnTest, None, None),
+                    ],
+                    agreement: vec![("obvhs".into(), agreement)],
+                }],
+            }],
+        }
     }
 
     #[test]
-    fn numbers_are_valid_json() {
-        assert_eq!(number(1.5), "1.5");
-        assert_eq!(number(3.0), "3");
-        assert_eq!(number(f64::NAN), "null");
-        assert_eq!(number(f64::INFINITY), "null");
+    fn the_document_has_every_field_with_its_meaning() {
+        let text = to_json(&report());
+        assert!(text.ends_with("}\n"));
+        let doc: Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(doc["command"], "raytrail bench --scene \"a b\\c\".ply\n");
+        assert_eq!(doc["baseline"], "stack");
+        assert_eq!(doc["passes"], 3);
+        assert_eq!(doc["threads"], json!([1, 4]));
+        let scene = &doc["scenes"][0];
+        assert_eq!(scene["name"], "dragon_vrip.ply.gz — ü");
+        assert_eq!((&scene["triangles"], &scene["width"], &scene["height"]), (&json!(12), &json!(64), &json!(48)));
+        assert_eq!(
+            scene["builds"],
+            json!([{"what": "raytrail sah", "seconds": 1.5, "bytes": {"nodes": 1024, "indices": 48}}])
+        );
+        let rays = &scene["rays"][0];
+        assert_eq!((&rays["type"], &rays["query"], &rays["rays"]), (&json!("shadow"), &json!("any"), &json!(10)));
+        assert_eq!(
+            rays["rows"][0],
+            json!({"target": "stack", "kind": "raytrail-bvh2", "threads": 4, "mrays_per_s": 3.0, "ratio": 1.0,
+                   "median_s": 0.25, "passes_s": [0.5, 0.25, null], "nodes_per_ray": 12.5,
+                   "leaves_per_ray": null, "tests_per_ray": null})
+        );
+        assert_eq!(rays["rows"][1]["ratio"], Value::Null);
+        assert_eq!(rays["rows"][1]["nodes_per_ray"], Value::Null);
+        assert_eq!(
+            rays["agreement"],
+            json!([{"target": "obvhs", "rays": 10, "exact": 7, "within_tolerance": 8,
+                    "classes": {"tie-equal-t": 1, "near-tie": 1}}])
+        );
+    }
+
+    #[test]
+    fn keys_keep_the_report_order() {
+        let text = to_json(&report());
+        let at = |key: &str| text.find(&format!("\"{key}\"")).unwrap_or_else(|| panic!("{key} missing"));
+        let order = ["command", "baseline", "passes", "threads", "scenes", "name", "builds", "rays", "rows"];
+        assert!(order.windows(2).all(|w| at(w[0]) < at(w[1])), "{text}");
+        // Maps keep the report's order too (not sorted): "nodes" before "indices".
+        assert!(at("nodes") < at("indices"));
+        assert!(at("tie-equal-t") < at("near-tie"));
     }
 }

@@ -21,9 +21,9 @@ mod target_gpu;
 
 use crate::progress::{timed, Progress};
 use options::Options;
-use raytrail::core::prepared::PreparedBvh2;
+use raytrail::core::method::{Bvh2Method, Method, Query};
+use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::Trace;
-use raytrail::core::traverse::{Method, Query};
 use raytrail::core::Hit;
 use raytrail::cpu::CpuScene;
 use raytrail::gpu::WgpuBackend;
@@ -109,17 +109,17 @@ fn bench_scene(path: &str, opts: &Options, pools: &[(usize, rayon::ThreadPool)])
     let bvh = bvh.map_err(|e| format!("{}: {e}", named.name))?;
     // The stack method always takes part: it makes the secondary rays and the reference hits.
     let mut methods = opts.methods.clone();
-    if !methods.contains(&Method::Stack) {
-        methods.push(Method::Stack);
+    if !methods.contains(&Method::Bvh2(Bvh2Method::Stack)) {
+        methods.push(Method::Bvh2(Bvh2Method::Stack));
     }
     let (prepared, _) = timed("deriving raytrail's layouts, hash tables and kd-tree", || {
-        largest.install(|| PreparedBvh2::new(scene, bvh, &methods))
+        largest.install(|| PreparedScene::new(scene, bvh, &methods))
     });
     let prepared = Arc::new(prepared.map_err(|e| format!("{}: {e}", named.name))?);
     let mut builds = raytrail_builds(opts, tree_s, &prepared);
     let cpu = CpuScene(prepared);
 
-    let stack = RaytrailCpu::new(Method::Stack, cpu.clone());
+    let stack = RaytrailCpu::new(Method::Bvh2(Bvh2Method::Stack), cpu.clone());
     let primary = rays::primary_rays(scene, opts.width, opts.height);
     let mut primary_hits = vec![Hit::MISS; primary.len()];
     stack.trace(largest, &primary, Query::Closest, &mut primary_hits)?;
@@ -163,7 +163,7 @@ fn bench_scene(path: &str, opts: &Options, pools: &[(usize, rayon::ThreadPool)])
 }
 
 /// raytrail's build steps and the memory of each part it derived.
-fn raytrail_builds(opts: &Options, tree_s: f64, p: &PreparedBvh2) -> Vec<Built> {
+fn raytrail_builds(opts: &Options, tree_s: f64, p: &PreparedScene) -> Vec<Built> {
     let mut out =
         vec![Built { what: format!("raytrail BVH2 ({})", opts.builder.name()), seconds: tree_s, bytes: vec![] }];
     let mut layout_bytes = Vec::new();

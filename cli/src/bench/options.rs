@@ -2,7 +2,7 @@
 
 use super::rays::RayKind;
 use crate::args::Args;
-use raytrail::core::traverse::Method;
+use raytrail::core::method::Method;
 use raytrail::{Builder, BUILTIN_SCENE};
 
 /// Every flag `raytrail bench` knows.
@@ -190,6 +190,7 @@ fn unique<T: PartialEq>(items: Vec<T>) -> Vec<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use raytrail::core::method::Bvh2Method;
 
     fn parse(s: &str) -> Result<Options, String> {
         Options::parse(&s.split_whitespace().map(str::to_string).collect::<Vec<_>>())
@@ -209,7 +210,7 @@ mod tests {
         assert_eq!(o.scenes, vec!["a.obj", "b.ply"]);
         assert_eq!(o.rays, vec![RayKind::Ao, RayKind::Primary]);
         assert_eq!(o.threads, vec![1, 2]);
-        assert_eq!(o.methods, vec![Method::Hash, Method::Stack]);
+        assert_eq!(o.methods, vec![Bvh2Method::Hash.into(), Bvh2Method::Stack.into()]);
         assert_eq!(o.baseline, "obvhs-bvh2", "peers run by default: the baseline is obvhs-bvh2");
         assert_eq!(
             parse("--peers none --methods uncle,stack").unwrap().baseline,

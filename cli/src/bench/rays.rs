@@ -6,8 +6,8 @@
 use glam::Vec3;
 use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
 use raytrail::conformance::rng::Pcg32;
+use raytrail::core::method::Query;
 use raytrail::core::scene::Scene;
-use raytrail::core::traverse::Query;
 use raytrail::core::{Hit, Ray};
 
 /// Length of an ambient-occlusion ray, as a fraction of the scene's diagonal.

@@ -1,9 +1,9 @@
 //! Bench targets: anything that traces a batch of rays into hits. raytrail's methods on a backend
 //! are targets, and so is each peer library; a new backend (wgpu) adds its own target type.
 
+use raytrail::core::method::{Method, Query, Structure};
 use raytrail::core::observe::Counters;
-use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
-use raytrail::core::traverse::{Family, Method, Query};
+use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 
@@ -113,7 +113,7 @@ impl RaytrailCpu {
         hits: &mut [Hit],
         record: Record,
     ) -> Result<Option<Counters>, String> {
-        let opts = TraceOptions { method: self.method, query, triangle_test: TriangleTestKind::Watertight, record };
+        let opts = TraceOptions::new(self.method).query(query).record(record);
         let report = pool
             .install(|| self.backend.trace(&self.scene, rays, &opts, hits))
             .map_err(|e| format!("{}: {e}", self.method))?;
@@ -127,9 +127,9 @@ impl BenchTarget for RaytrailCpu {
     }
 
     fn kind(&self) -> TargetKind {
-        match self.method.family() {
-            Family::Bvh2 => TargetKind::RaytrailBvh2,
-            Family::Kd => TargetKind::RaytrailKd,
+        match self.method.structure() {
+            Structure::Kd => TargetKind::RaytrailKd,
+            _ => TargetKind::RaytrailBvh2,
         }
     }
 

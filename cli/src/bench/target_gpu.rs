@@ -1,8 +1,8 @@
 //! raytrail's methods on the GPU as bench targets (the wgpu backend).
 
 use super::target::{BenchTarget, TargetKind, Work};
-use raytrail::core::trace::{Record, Trace, TraceOptions, TriangleTestKind};
-use raytrail::core::traverse::{Method, Query};
+use raytrail::core::method::{Method, Query};
+use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::gpu::{WgpuBackend, WgpuScene};
 use std::sync::Arc;
@@ -28,7 +28,7 @@ impl RaytrailGpu {
         hits: &mut [Hit],
         record: Record,
     ) -> Result<raytrail::core::trace::Report, String> {
-        let opts = TraceOptions { method: self.method, query, triangle_test: TriangleTestKind::Watertight, record };
+        let opts = TraceOptions::new(self.method).query(query).record(record);
         self.backend.trace(&self.scene, rays, &opts, hits).map_err(|e| format!("{}: {e}", self.name))
     }
 }

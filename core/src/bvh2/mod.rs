@@ -5,9 +5,11 @@
 //! - [`BinaryLayout`]: the Aila-Laine layout (both child boxes in the parent, leaf triangle arrays
 //!   closed by a termination marker) with uncle or parent/sibling links in the padding.
 //! - [`BvhMemory`]: the narrow read interface traversals use.
+//! - [`traverse`]: the traversal state machines (methods a-f).
 
 mod memory;
 mod node;
+pub mod traverse;
 pub use memory::{BvhMemory, MemRead, SliceMemory};
 pub use node::{BinaryNode, LeafWord, NodeRef};
 

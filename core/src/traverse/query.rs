@@ -1,4 +1,5 @@
 use crate::intersect::TriangleHit;
+use crate::method::Query;
 use crate::{Hit, Ray};
 
 /// The answer being built for one ray.
@@ -13,10 +14,10 @@ pub struct QueryState {
 }
 
 impl QueryState {
-    /// A query for `ray`, closest hit or any hit.
+    /// An empty answer to `query` for `ray`.
     #[inline(always)]
-    pub fn new(ray: &Ray, any: bool) -> Self {
-        Self { hit: Hit::MISS, any, tmax: ray.tmax }
+    pub fn new(ray: &Ray, query: Query) -> Self {
+        Self { hit: Hit::MISS, any: query.is_any(), tmax: ray.tmax }
     }
 
     /// Current culling distance: the closest hit so far, or the ray's `tmax`. Inclusive, so a

@@ -22,13 +22,14 @@ pub use memory::{CountingMemory, Table, Traffic};
 pub use sim::{simulate, CycleRecord, MethodReport, MethodRun, SimConfig, Transition};
 
 use raytrail_conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
+use raytrail_core::bvh2::traverse::trace_ray;
 use raytrail_core::bvh2::SahBuilder;
 use raytrail_core::intersect::Watertight;
 use raytrail_core::key::KeyWidth;
+use raytrail_core::method::{Bvh2Method, Method, Query};
 use raytrail_core::observe::NoObserver;
-use raytrail_core::prepared::PreparedBvh2;
+use raytrail_core::prepared::PreparedScene;
 use raytrail_core::scene::Scene;
-use raytrail_core::traverse::{trace_ray, Method, Query};
 use raytrail_core::{Hit, Ray};
 
 /// The ray sets the simulator can make.
@@ -78,7 +79,7 @@ pub struct Scenario {
     /// The scene.
     pub scene: Scene,
     /// Tree, layouts and hash tables for every method.
-    pub prepared: PreparedBvh2,
+    pub prepared: PreparedScene,
     /// The rays, in the order they are grouped into warps.
     pub rays: Vec<Ray>,
     /// What the rays are.
@@ -90,7 +91,7 @@ impl Scenario {
     /// `width` x `height` camera framing the scene (shadow and diffuse rays start at its hits).
     pub fn new(scene: Scene, kind: RayKind, width: u32, height: u32) -> Result<Scenario, String> {
         let bvh = SahBuilder::default().build(scene.triangles()).map_err(|e| e.to_string())?;
-        let prepared = PreparedBvh2::new(&scene, bvh, &Method::BVH2).map_err(|e| e.to_string())?;
+        let prepared = PreparedScene::new(&scene, bvh, &Method::BVH2).map_err(|e| e.to_string())?;
         let camera = primary(&scene, width, height);
         let rays = match kind {
             RayKind::Primary => camera,
@@ -110,16 +111,16 @@ impl Scenario {
 
 /// Hits of `rays` with the stack method through `trace_ray`, one ray after another (no lockstep):
 /// the reference the simulator must reproduce.
-pub fn reference_hits(prepared: &PreparedBvh2, rays: &[Ray], query: Query) -> Result<Vec<Hit>, raytrail_core::Error> {
-    let (mem, root) = (prepared.memory(Method::Stack)?, prepared.root(Method::Stack)?);
+pub fn reference_hits(prepared: &PreparedScene, rays: &[Ray], query: Query) -> Result<Vec<Hit>, raytrail_core::Error> {
+    let (mem, root) = (prepared.memory(Bvh2Method::Stack)?, prepared.root(Bvh2Method::Stack)?);
     Ok(match prepared.key_width() {
         KeyWidth::W32 => rays
             .iter()
-            .map(|r| trace_ray::<u32, _, Watertight, _>(Method::Stack, &mem, root, r, query, &mut NoObserver))
+            .map(|r| trace_ray::<u32, _, Watertight, _>(Bvh2Method::Stack, &mem, root, r, query, &mut NoObserver))
             .collect(),
         KeyWidth::W64 => rays
             .iter()
-            .map(|r| trace_ray::<u64, _, Watertight, _>(Method::Stack, &mem, root, r, query, &mut NoObserver))
+            .map(|r| trace_ray::<u64, _, Watertight, _>(Bvh2Method::Stack, &mem, root, r, query, &mut NoObserver))
             .collect(),
     })
 }

@@ -1,13 +1,14 @@
 //! One interface over the core's per-method state machines, so a lane can be stepped whatever
 //! its method.
 
+use raytrail_core::bvh2::traverse::{
+    ParentSiblingState, Paused, PerfectHashLookup, RegisterState, StackState, UncleHops,
+};
 use raytrail_core::bvh2::{BvhMemory, NodeRef};
 use raytrail_core::intersect::{RayContext, TriangleTest};
 use raytrail_core::key::Key;
 use raytrail_core::observe::Observer;
-use raytrail_core::traverse::{
-    ParentSiblingState, Paused, PerfectHashLookup, QueryState, RegisterState, StackState, Step, UncleHops,
-};
+use raytrail_core::traverse::{QueryState, Step};
 
 /// A per-ray traversal state that makes one transition per [`Machine::step`].
 pub trait Machine: Sized {

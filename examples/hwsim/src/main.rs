@@ -1,6 +1,6 @@
 //! `raytrail-hwsim`: compares raytrail's traversal methods stepped in lockstep warps.
 
-use raytrail_core::traverse::Method;
+use raytrail_core::method::{Bvh2Method, Method};
 use raytrail_hwsim::{report, simulate, RayKind, Scenario, SimConfig};
 use std::path::Path;
 
@@ -113,7 +113,7 @@ fn run(a: &Args) -> Result<(), String> {
         reports.push(run.report);
     }
     print!("{}", report::tables(&reports));
-    if reports.iter().any(|r| r.method == Method::HashResume) {
+    if reports.iter().any(|r| r.method == Method::Bvh2(Bvh2Method::HashResume)) {
         println!(
             "  hash-resume runs in lockstep too: a lane pauses after each leaf with a hit and resumes from key and\n  \
              trail within the same cycle; the resume's hash lookup counts as hash traffic."

@@ -3,15 +3,16 @@
 
 use crate::machine::{Machine, Resuming};
 use crate::memory::{CountingMemory, Traffic};
+use raytrail_core::bvh2::traverse::{
+    order_children, Descent, ParentSiblingState, PerfectHashLookup, RegisterState, StackState, TraceRoot, UncleHops,
+};
 use raytrail_core::bvh2::{BvhMemory, NodeRef};
 use raytrail_core::intersect::{RayContext, Watertight};
 use raytrail_core::key::{Key, KeyWidth};
+use raytrail_core::method::{Bvh2Method, Method, Query};
 use raytrail_core::observe::{Backtrack, Counters, Observer};
-use raytrail_core::prepared::PreparedBvh2;
-use raytrail_core::traverse::{
-    order_children, Descent, Method, ParentSiblingState, PerfectHashLookup, Query, QueryState, RegisterState,
-    StackState, Step, TraceRoot, UncleHops,
-};
+use raytrail_core::prepared::PreparedScene;
+use raytrail_core::traverse::{QueryState, Step};
 use raytrail_core::{Error, Hit, Ray};
 
 /// How to simulate.
@@ -174,7 +175,7 @@ impl MethodReport {
     /// Bytes per ray moved to and from a stack (4-byte node references pushed and popped);
     /// `None` for the stackless methods, which move none.
     pub fn stack_bytes_per_ray(&self) -> Option<f64> {
-        matches!(self.method, Method::Stack | Method::StackDisjoint)
+        matches!(self.method, Method::Bvh2(Bvh2Method::Stack) | Method::Bvh2(Bvh2Method::StackDisjoint))
             .then(|| self.per_ray(4 * (self.postponed + self.transitions.stack_pop)))
     }
 }
@@ -204,7 +205,13 @@ pub struct MethodRun {
 
 /// Simulates `method` over `rays` in lockstep warps, with the watertight triangle test and the key
 /// width the tree needs (`u32` or `u64`).
-pub fn simulate(prepared: &PreparedBvh2, method: Method, rays: &[Ray], cfg: &SimConfig) -> Result<MethodRun, Error> {
+pub fn simulate(
+    prepared: &PreparedScene,
+    method: impl Into<Method>,
+    rays: &[Ray],
+    cfg: &SimConfig,
+) -> Result<MethodRun, Error> {
+    let method = method.into();
     match prepared.key_width() {
         KeyWidth::W32 => simulate_keyed::<u32>(prepared, method, rays, cfg),
         KeyWidth::W64 => simulate_keyed::<u64>(prepared, method, rays, cfg),
@@ -212,34 +219,30 @@ pub fn simulate(prepared: &PreparedBvh2, method: Method, rays: &[Ray], cfg: &Sim
 }
 
 fn simulate_keyed<K: Key>(
-    prepared: &PreparedBvh2,
+    prepared: &PreparedScene,
     method: Method,
     rays: &[Ray],
     cfg: &SimConfig,
 ) -> Result<MethodRun, Error> {
-    let mem = CountingMemory::new(prepared.memory(method)?);
-    let root = prepared.root(method)?;
+    // The simulator steps BVH2 traversals; another structure's method is an `Unsupported` error.
+    let m = Bvh2Method::try_from(method)?;
+    let mem = CountingMemory::new(prepared.memory(m)?);
+    let root = prepared.root(m)?;
     let stats = prepared.bvh.stats();
     let sim = Sim { mem: &mem, root, cfg };
-    let mut run = match method {
-        Method::Stack => sim.run::<StackState<false>>(rays),
-        Method::StackDisjoint => sim.run::<StackState<true>>(rays),
-        Method::ParentSibling => sim.run::<ParentSiblingState<K>>(rays),
-        Method::Uncle => sim.run::<RegisterState<K, UncleHops, false>>(rays),
-        Method::Hash => sim.run::<RegisterState<K, PerfectHashLookup, false>>(rays),
-        Method::HashDisjoint => sim.run::<RegisterState<K, PerfectHashLookup, true>>(rays),
-        Method::HashResume => sim.run::<Resuming<K>>(rays),
-        kd => {
-            return Err(Error::NotPrepared {
-                method: kd.name(),
-                missing: "a BVH2 method (the simulator steps BVH2 traversals)",
-            })
-        }
+    let mut run = match m {
+        Bvh2Method::Stack => sim.run::<StackState<false>>(rays),
+        Bvh2Method::StackDisjoint => sim.run::<StackState<true>>(rays),
+        Bvh2Method::ParentSibling => sim.run::<ParentSiblingState<K>>(rays),
+        Bvh2Method::Uncle => sim.run::<RegisterState<K, UncleHops, false>>(rays),
+        Bvh2Method::Hash => sim.run::<RegisterState<K, PerfectHashLookup, false>>(rays),
+        Bvh2Method::HashDisjoint => sim.run::<RegisterState<K, PerfectHashLookup, true>>(rays),
+        Bvh2Method::HashResume => sim.run::<Resuming<K>>(rays),
     };
     run.report.method = method;
     run.report.traffic = mem.traffic();
     run.report.state_bytes = method.state_bytes(stats.depth, K::WIDTH.bytes());
-    if !matches!(method, Method::Stack | Method::StackDisjoint) {
+    if !matches!(method, Method::Bvh2(Bvh2Method::Stack) | Method::Bvh2(Bvh2Method::StackDisjoint)) {
         run.report.peak_stack = 0;
     }
     Ok(run)
@@ -309,7 +312,7 @@ impl<M: BvhMemory> Sim<'_, M> {
         let warp = self.cfg.warp.max(1);
         let mut out = MethodRun {
             report: MethodReport {
-                method: Method::Stack,
+                method: Method::Bvh2(Bvh2Method::Stack),
                 rays: rays.len(),
                 warp,
                 warps: rays.len().div_ceil(warp),
@@ -349,7 +352,6 @@ impl<M: BvhMemory> Sim<'_, M> {
         out: &mut MethodRun,
     ) {
         let record_lanes = timeline.is_some();
-        let any = self.cfg.query == Query::Any;
         let mut lanes: Vec<Lane<S>> = rays
             .iter()
             .enumerate()
@@ -358,7 +360,7 @@ impl<M: BvhMemory> Sim<'_, M> {
                 Lane {
                     ray: first + i,
                     state: S::start(self.root.node),
-                    q: QueryState::new(ray, any),
+                    q: QueryState::new(ray, self.cfg.query),
                     obs: LaneObserver { nodes: self.cfg.record_enumerations.then(Vec::new), ..LaneObserver::default() },
                     steps: 0,
                     live_stack: 0,

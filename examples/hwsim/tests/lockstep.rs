@@ -3,10 +3,11 @@
 
 use raytrail_conformance::rays::{adversarial, uniform_random, RAY_SEED};
 use raytrail_conformance::scenes::{degenerate_stack, sphereflake, SCENE_SEED};
+use raytrail_core::bvh2::traverse::trace_ray;
 use raytrail_core::intersect::Watertight;
 use raytrail_core::key::{Key, KeyWidth};
+use raytrail_core::method::{Bvh2Method, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
-use raytrail_core::traverse::{trace_ray, Method, Query};
 use raytrail_core::Ray;
 use raytrail_hwsim::{reference_hits, simulate, RayKind, Scenario, SimConfig};
 
@@ -14,7 +15,7 @@ use raytrail_hwsim::{reference_hits, simulate, RayKind, Scenario, SimConfig};
 fn check<K: Key>(s: &Scenario, rays: &[Ray], query: Query, warp: usize) {
     assert_eq!(s.prepared.key_width(), K::WIDTH);
     let stack = reference_hits(&s.prepared, rays, query).unwrap();
-    for m in Method::BVH2 {
+    for m in Bvh2Method::ALL {
         let cfg = SimConfig { warp, record_enumerations: true, ..SimConfig::new(query) };
         let run = simulate(&s.prepared, m, rays, &cfg).unwrap();
         let (mem, root) = (s.prepared.memory(m).unwrap(), s.prepared.root(m).unwrap());
@@ -42,7 +43,7 @@ fn check<K: Key>(s: &Scenario, rays: &[Ray], query: Query, warp: usize) {
         assert!(r.cycles * warp as u64 >= r.lane_steps && r.lane_steps >= r.cycles, "{m}");
         assert!(r.latency_cycles >= r.cycles, "{m}");
         assert_eq!(r.warps, rays.len().div_ceil(warp), "{m}");
-        if m == Method::Stack && query == Query::Closest {
+        if m == Bvh2Method::Stack && query == Query::Closest {
             // A closest-hit stack traversal ends with an empty stack: every push is popped.
             assert_eq!(r.postponed, r.transitions.stack_pop, "{m}");
         }
@@ -83,7 +84,8 @@ fn sixty_four_bit_keys_are_simulated_too() {
 fn a_warp_of_one_lane_is_always_fully_active() {
     let s = Scenario::new(sphereflake(1), RayKind::Primary, 16, 12).unwrap();
     let run =
-        simulate(&s.prepared, Method::Hash, &s.rays, &SimConfig { warp: 1, ..SimConfig::new(Query::Closest) }).unwrap();
+        simulate(&s.prepared, Bvh2Method::Hash, &s.rays, &SimConfig { warp: 1, ..SimConfig::new(Query::Closest) })
+            .unwrap();
     let r = &run.report;
     assert_eq!(r.cycles, r.lane_steps);
     // Rays that miss the root's children still take one step, so every ray takes at least one.
@@ -94,9 +96,15 @@ fn a_warp_of_one_lane_is_always_fully_active() {
 fn stackless_methods_move_no_stack_bytes_and_hold_less_state() {
     let s = Scenario::new(sphereflake(1), RayKind::Primary, 16, 12).unwrap();
     let cfg = SimConfig { record_timeline: true, ..SimConfig::new(Query::Closest) };
-    let stack = simulate(&s.prepared, Method::Stack, &s.rays, &cfg).unwrap().report;
+    let stack = simulate(&s.prepared, Bvh2Method::Stack, &s.rays, &cfg).unwrap().report;
     assert!(stack.stack_bytes_per_ray().unwrap() > 0.0);
-    for m in [Method::ParentSibling, Method::Uncle, Method::Hash, Method::HashDisjoint, Method::HashResume] {
+    for m in [
+        Bvh2Method::ParentSibling,
+        Bvh2Method::Uncle,
+        Bvh2Method::Hash,
+        Bvh2Method::HashDisjoint,
+        Bvh2Method::HashResume,
+    ] {
         let run = simulate(&s.prepared, m, &s.rays, &cfg).unwrap();
         assert_eq!(run.report.stack_bytes_per_ray(), None, "{m}");
         assert_eq!(run.report.transitions.stack_pop, 0, "{m}");

@@ -12,8 +12,8 @@ mod obvhs;
 use super::report::Built;
 use super::target::{BenchTarget, TargetKind, Targets, Work};
 use rayon::prelude::*;
+use raytrail::core::method::Query;
 use raytrail::core::scene::Scene;
-use raytrail::core::traverse::Query;
 use raytrail::core::{Hit, Ray};
 use std::sync::Arc;
 

@@ -5,10 +5,11 @@
 //! - [`KdStackState`]: the standard stack traversal (A.1);
 //! - [`KdRestartState`]: kd-restart (A.2), push-down (A.3) and short-stack (A.4), which differ in
 //!   whether the restart point moves down and how many entries the stack keeps;
-//! - [`trace_kd_packet`]: the packetized short-stack (A.5).
+//! - [`trace_kd_packet`]: the packetized short-stack (A.5), over packets grouped by [`packets`].
 
 mod leaf;
 mod packet;
+pub mod packets;
 mod restart;
 mod run;
 mod split;
@@ -16,7 +17,7 @@ mod stack;
 
 pub use leaf::kd_leaf;
 pub use packet::{trace_kd_packet, PACKET_WIDTH};
-pub use restart::{KdRestartState, SHORT_STACK_MAX};
+pub use restart::{KdRestartState, RestartPolicy, SHORT_STACK_MAX};
 pub use run::{scene_interval, trace_kd_ray, KdRoot};
 pub use split::{cross, Crossing};
 pub use stack::KdStackState;

@@ -1,9 +1,10 @@
-use super::{cross, kd_leaf, scene_interval, Crossing, KdRoot, SHORT_STACK_MAX};
+use super::{cross, kd_leaf, scene_interval, Crossing, KdRoot, RestartPolicy, SHORT_STACK_MAX};
 use crate::bvh2::NodeRef;
 use crate::intersect::{KdRayContext, NoPair, TriangleTest};
 use crate::kd::KdMemory;
+use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::{begin, Query, QueryState};
+use crate::traverse::{begin, QueryState};
 use crate::{Hit, Ray};
 
 /// Rays per packet: four, as on the paper's GPU and in one SSE register.
@@ -27,25 +28,23 @@ struct Entry<const W: usize> {
 /// leaves it would visit alone, in the same order, and stops at the same early exit. A.5 restarts
 /// every ray from the previous leaf's exit; here each ray restarts from the exit of the last leaf
 /// it was live in, which is what keeps restarts exact when rays go inactive.
-#[allow(clippy::too_many_arguments)]
 pub fn trace_kd_packet<const W: usize, M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
     mem: &M,
     root: &KdRoot,
     rays: &[Ray],
-    any: bool,
-    capacity: usize,
-    push_down: bool,
+    query: Query,
+    policy: RestartPolicy,
     hits: &mut [Hit],
     obs: &mut [O],
 ) {
     let n = rays.len().min(W).min(hits.len()).min(obs.len());
+    let RestartPolicy { push_down, short_stack: capacity } = policy;
     let capacity = capacity.min(SHORT_STACK_MAX);
     let mut ctx: [Option<KdRayContext<T>>; W] = core::array::from_fn(|_| None);
-    let mut q: [QueryState; W] = core::array::from_fn(|i| QueryState::new(&rays[i.min(n.saturating_sub(1))], any));
+    let mut q: [QueryState; W] = core::array::from_fn(|i| QueryState::new(&rays[i.min(n.saturating_sub(1))], query));
     let (mut t_min, mut t_max, mut scene_max) = ([0.0f32; W], [0.0f32; W], [0.0f32; W]);
     let mut done = [true; W];
     for i in 0..n {
-        let query = if any { Query::Any } else { Query::Closest };
         if let Some((c, qi)) = begin::<T, NoPair>(&rays[i], root.scene_scale, query) {
             if let Some((a, b)) = scene_interval(&c, root) {
                 (t_min[i], t_max[i], scene_max[i], done[i]) = (a, b, b, false);

@@ -8,6 +8,28 @@ use crate::traverse::{QueryState, Step};
 /// Most entries a short stack may keep.
 pub const SHORT_STACK_MAX: usize = 16;
 
+/// How a restarting kd traversal backtracks: whether the restart point moves down (A.3) and how
+/// many entries its short stack keeps (A.4; 0: none).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RestartPolicy {
+    /// The restart point follows descents that entered a single child.
+    pub push_down: bool,
+    /// Entries of the short stack, at most [`SHORT_STACK_MAX`].
+    pub short_stack: usize,
+}
+
+impl RestartPolicy {
+    /// kd-restart (A.2): back to the root after every leaf.
+    pub const RESTART: RestartPolicy = RestartPolicy { push_down: false, short_stack: 0 };
+    /// Push-down (A.3).
+    pub const PUSH_DOWN: RestartPolicy = RestartPolicy { push_down: true, short_stack: 0 };
+
+    /// Short-stack (A.4): push-down and a stack of `entries`.
+    pub const fn short_stack(entries: usize) -> RestartPolicy {
+        RestartPolicy { push_down: true, short_stack: entries }
+    }
+}
+
 /// kd-restart and its refinements (Horn et al. 2007, A.2-A.4), one state for the three:
 /// - restart (A.2): no stack, no push-down: after a leaf, step the segment's start to the leaf's
 ///   exit and descend again from the root;
@@ -32,10 +54,10 @@ pub struct KdRestartState {
 }
 
 impl KdRestartState {
-    /// Starts at the root over `[t_min, scene_max]`, with push-down or not and a short stack of
-    /// `capacity` entries (0: none; at most [`SHORT_STACK_MAX`]).
+    /// Starts at the root over `[t_min, scene_max]`, backtracking as `policy` says.
     #[inline(always)]
-    pub fn new(t_min: f32, scene_max: f32, push_down: bool, capacity: usize) -> Self {
+    pub fn new(t_min: f32, scene_max: f32, policy: RestartPolicy) -> Self {
+        let RestartPolicy { push_down, short_stack: capacity } = policy;
         Self {
             node: 0,
             t_min,

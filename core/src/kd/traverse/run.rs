@@ -1,8 +1,9 @@
-use super::{KdRestartState, KdStackState};
+use super::{trace_kd_packet, KdRestartState, KdStackState, RestartPolicy};
 use crate::intersect::{KdRayContext, SlabRay, TriangleTest};
 use crate::kd::KdMemory;
+use crate::method::{KdMethod, Query};
 use crate::observe::Observer;
-use crate::traverse::{begin_slab, Method, Query, QueryState, Step};
+use crate::traverse::{begin_slab, QueryState, Step};
 use crate::{Hit, Ray};
 use glam::Vec3;
 
@@ -38,17 +39,31 @@ fn scene_segment(ray: &Ray, slab: &SlabRay, root: &KdRoot) -> Option<(f32, f32)>
     slab.hit(root.lo, root.hi, lo, hi).map(|h| (h.t_enter, h.t_exit))
 }
 
-/// Traces one ray with a single-ray kd method (stack, restart, push-down, short-stack).
-/// Other methods return a miss; the packet method goes through [`super::trace_kd_packet`].
+/// Traces one ray with `method`. The packet method traces it as a packet of one ray (the same
+/// hits and leaves; batches of rays go through [`super::trace_kd_packet`] in packets of an octant).
 #[inline]
 pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
-    method: Method,
+    method: KdMethod,
     mem: &M,
     root: &KdRoot,
     ray: &Ray,
     query: Query,
     obs: &mut O,
 ) -> Hit {
+    if method == KdMethod::Packet {
+        let mut hit = [Hit::MISS];
+        let policy = RestartPolicy::short_stack(root.short_stack);
+        trace_kd_packet::<1, M, T, O>(
+            mem,
+            root,
+            core::slice::from_ref(ray),
+            query,
+            policy,
+            &mut hit,
+            core::slice::from_mut(obs),
+        );
+        return hit[0];
+    }
     // The scene box is tested before the rest of the context is made: most secondary rays that
     // leave the scene do so here (97% of Sponza's ambient-occlusion rays), and for them the
     // context and query state were stores that the box test's loads then waited on.
@@ -59,7 +74,7 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
         return Hit::MISS;
     };
     let ctx = KdRayContext::<T>::from_slab(ray, slab);
-    let mut q = QueryState::new(ray, query == Query::Any);
+    let mut q = QueryState::new(ray, query);
     macro_rules! drive {
         ($state:expr) => {{
             let mut s = $state;
@@ -70,11 +85,13 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
         }};
     }
     match method {
-        Method::KdStack => drive!(KdStackState::new(t0, t1)),
-        Method::KdRestart => drive!(KdRestartState::new(t0, t1, false, 0)),
-        Method::KdPushDown => drive!(KdRestartState::new(t0, t1, true, 0)),
-        Method::KdShortStack => drive!(KdRestartState::new(t0, t1, true, root.short_stack)),
-        _ => return Hit::MISS,
+        KdMethod::Stack => drive!(KdStackState::new(t0, t1)),
+        KdMethod::Restart => drive!(KdRestartState::new(t0, t1, RestartPolicy::RESTART)),
+        KdMethod::PushDown => drive!(KdRestartState::new(t0, t1, RestartPolicy::PUSH_DOWN)),
+        // The packet method went its own way above.
+        KdMethod::ShortStack | KdMethod::Packet => {
+            drive!(KdRestartState::new(t0, t1, RestartPolicy::short_stack(root.short_stack)))
+        }
     }
     q.hit
 }

@@ -1,9 +1,10 @@
-use super::{intersect_leaf, order_children, Descent, QueryState, Step};
+use super::{intersect_leaf, order_children, Descent};
 use crate::bvh2::{BvhMemory, NodeRef};
 use crate::hash::lookup;
 use crate::intersect::{RayContext, TriangleTest};
 use crate::key::{self, Key};
 use crate::observe::{Backtrack, Observer, RegisterSource};
+use crate::traverse::{QueryState, Step};
 
 /// How a [`RegisterState`] finds the next node when the register is empty.
 pub trait Fallback {

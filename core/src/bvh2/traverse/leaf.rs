@@ -1,7 +1,7 @@
-use super::QueryState;
 use crate::bvh2::{BvhMemory, NodeRef};
 use crate::intersect::{RayContext, TriangleTest};
 use crate::observe::Observer;
+use crate::traverse::QueryState;
 
 /// Tests the ray against every triangle of the leaf at `offset`.
 ///

@@ -1,14 +1,17 @@
-//! A canonical tree with the layouts and tables its methods need, and nothing more.
+//! A scene prepared for tracing: the canonical tree with the layouts and tables its methods need,
+//! and nothing more, plus the conventions every backend shares about it ([`PreparedScene::canonical_ids`]).
 
+mod enumeration;
+
+use crate::bvh2::traverse::TraceRoot;
 use crate::bvh2::{BinaryLayout, Bvh2, LinkKind, NodeRef, SliceMemory};
 use crate::geometry::Triangle;
 use crate::hash::{keys_to_hash, HashCoverage, HashShape, HashStats, PerfectHash};
 use crate::kd::traverse::KdRoot;
 use crate::kd::{KdBuilder, KdSliceMemory, KdTree};
 use crate::key::KeyWidth;
+use crate::method::{Bvh2Method, Method, Structure};
 use crate::scene::Scene;
-use crate::traverse::Family;
-use crate::traverse::{Method, TraceRoot};
 use crate::Error;
 use alloc::vec::Vec;
 
@@ -45,10 +48,11 @@ pub struct BuiltHash {
     pub stats: HashStats,
 }
 
-/// The canonical BVH2 of a scene, with exactly the layouts and hash tables the requested methods
-/// use: a scene traced only with the stack method pays for no hash and no parent links.
+/// A scene ready to trace: its canonical BVH2 with exactly the layouts and hash tables the
+/// requested methods use, and its kd-tree if a kd method was requested. A scene traced only with
+/// the stack method pays for no hash, no parent links and no kd-tree.
 #[derive(Clone, Debug)]
-pub struct PreparedBvh2 {
+pub struct PreparedScene {
     /// The canonical tree.
     pub bvh: Bvh2,
     /// Layout with uncle links (every method but parent/sibling).
@@ -79,9 +83,9 @@ fn seconds_since(_start: Option<f64>) -> f64 {
     0.0
 }
 
-impl PreparedBvh2 {
+impl PreparedScene {
     /// Derives what `methods` need from `bvh` over `scene`.
-    pub fn new(scene: &Scene, bvh: Bvh2, methods: &[Method]) -> Result<PreparedBvh2, Error> {
+    pub fn new(scene: &Scene, bvh: Bvh2, methods: &[Method]) -> Result<PreparedScene, Error> {
         let tris = scene.triangles();
         let mut timings = PrepareTimings::default();
         let t0 = seconds_since(None);
@@ -110,14 +114,14 @@ impl PreparedBvh2 {
             if methods.iter().any(|m| m.needs_full_hash()) { Some(build(HashCoverage::All)?) } else { None };
         timings.full_hash = seconds_since(Some(t2));
         let t3 = seconds_since(None);
-        let kd = if methods.iter().any(|m| m.family() == Family::Kd) {
+        let kd = if methods.iter().any(|m| m.structure() == Structure::Kd) {
             let tree = KdBuilder::default().build(tris)?;
             Some(PreparedKd { tree, triangles: tris.to_vec(), short_stack: 3 })
         } else {
             None
         };
         timings.kd = seconds_since(Some(t3));
-        Ok(PreparedBvh2 { bvh, uncles, parents, hash, full_hash, kd, timings })
+        Ok(PreparedScene { bvh, uncles, parents, hash, full_hash, kd, timings })
     }
 
     /// Key width the tree's depth needs.
@@ -126,7 +130,7 @@ impl PreparedBvh2 {
     }
 
     /// The layout `method` traverses.
-    pub fn layout(&self, method: Method) -> Result<&BinaryLayout, Error> {
+    pub fn layout(&self, method: Bvh2Method) -> Result<&BinaryLayout, Error> {
         let (l, what) = if method.needs_parent_links() {
             (&self.parents, "the parent/sibling layout")
         } else {
@@ -136,7 +140,7 @@ impl PreparedBvh2 {
     }
 
     /// The memory `method` reads: its layout and, for the hash methods, their tables.
-    pub fn memory(&self, method: Method) -> Result<SliceMemory<'_>, Error> {
+    pub fn memory(&self, method: Bvh2Method) -> Result<SliceMemory<'_>, Error> {
         let layout = self.layout(method)?;
         let hash = if method.needs_full_hash() {
             Some(
@@ -159,7 +163,7 @@ impl PreparedBvh2 {
     }
 
     /// Where `method` starts.
-    pub fn root(&self, method: Method) -> Result<TraceRoot, Error> {
+    pub fn root(&self, method: Bvh2Method) -> Result<TraceRoot, Error> {
         let b = self.bvh.nodes()[0].bounds;
         let scene_scale = b.min.abs().max(b.max.abs()).max_element();
         Ok(TraceRoot { node: self.layout(method)?.root, scene_scale, max_steps: self.bvh.len() as u32 })
@@ -182,6 +186,15 @@ impl PreparedBvh2 {
             max_steps: (kd.tree.nodes().len() + 66 * kd.tree.stats().leaves).min(u32::MAX as usize) as u32,
             short_stack: kd.short_stack,
         })
+    }
+
+    /// Checks that the scene holds everything `method` reads, so a backend fails before it
+    /// starts (and before it times anything).
+    pub fn check_prepared(&self, method: Method) -> Result<(), Error> {
+        match method {
+            Method::Bvh2(m) => self.memory(m).map(|_| ()),
+            Method::Kd(_) => self.kd_memory().map(|_| ()),
+        }
     }
 
     /// Bytes of the uncle layout (the BVH the hash overhead is relative to).

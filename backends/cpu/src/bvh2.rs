@@ -1,48 +1,44 @@
-//! Picks the monomorphized traversal loop for a batch: key width x triangle test x recording.
+//! The BVH2 methods' loop for one chunk, monomorphized per key width x triangle test x recording.
 
-use raytrail_core::bvh2::{BinaryLayout, SliceMemory};
+use crate::chunk::Chunk;
+use raytrail_core::bvh2::traverse::{trace_batch, trace_ray, TraceRoot};
+use raytrail_core::bvh2::SliceMemory;
 use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use raytrail_core::key::{Key, KeyWidth};
+use raytrail_core::method::{Bvh2Method, Method};
 use raytrail_core::observe::{Both, Counters, NoObserver, Recorder};
-use raytrail_core::prepared::PreparedBvh2;
+use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
-use raytrail_core::traverse::{trace_batch, trace_ray, Family, TraceRoot};
-use raytrail_core::{Error, Hit, Ray};
+use raytrail_core::Error;
 
-/// One chunk's rays, hit slots and (when recorded) enumeration slots.
-pub(crate) struct Chunk<'a> {
-    pub rays: &'a [Ray],
-    pub hits: &'a mut [Hit],
-    pub enumerations: &'a mut [Vec<u32>],
-}
-
-/// Traces one chunk; returns its counters (only `rays` is set when nothing is recorded).
-pub(crate) fn trace_chunk(scene: &PreparedBvh2, opts: &TraceOptions, chunk: Chunk<'_>) -> Result<Counters, Error> {
-    if opts.method.family() == Family::Kd {
-        return crate::dispatch_kd::trace_kd_chunk(scene, opts, chunk);
-    }
-    let mem = scene.memory(opts.method)?;
-    let root = scene.root(opts.method)?;
-    let layout = scene.layout(opts.method)?;
-    let run = Run { opts, mem, root, layout };
-    Ok(match (scene.key_width(), opts.triangle_test) {
+/// Traces one chunk with `method`; returns its counters (only `rays` is set when nothing is
+/// recorded).
+pub(crate) fn trace_chunk(
+    scene: &PreparedScene,
+    method: Bvh2Method,
+    opts: &TraceOptions,
+    chunk: Chunk<'_>,
+) -> Result<Counters, Error> {
+    let run = Run { scene, method, opts, mem: scene.memory(method)?, root: scene.root(method)? };
+    match (scene.key_width(), opts.triangle_test) {
         (KeyWidth::W32, TriangleTestKind::Watertight) => run.go::<u32, Watertight>(chunk),
         (KeyWidth::W32, TriangleTestKind::MollerTrumbore) => run.go::<u32, MollerTrumbore>(chunk),
         (KeyWidth::W64, TriangleTestKind::Watertight) => run.go::<u64, Watertight>(chunk),
         (KeyWidth::W64, TriangleTestKind::MollerTrumbore) => run.go::<u64, MollerTrumbore>(chunk),
-    })
+    }
 }
 
 struct Run<'a> {
+    scene: &'a PreparedScene,
+    method: Bvh2Method,
     opts: &'a TraceOptions,
     mem: SliceMemory<'a>,
     root: TraceRoot,
-    layout: &'a BinaryLayout,
 }
 
 impl Run<'_> {
-    fn go<K: Key, T: TriangleTest>(&self, chunk: Chunk<'_>) -> Counters {
-        let (method, query) = (self.opts.method, self.opts.query);
+    fn go<K: Key, T: TriangleTest>(&self, chunk: Chunk<'_>) -> Result<Counters, Error> {
+        let (method, query) = (self.method, self.opts.query);
         let mut counters = Counters::default();
         match self.opts.record {
             Record::Nothing => {
@@ -57,11 +53,11 @@ impl Run<'_> {
                     let mut obs = Both(counters, Recorder::default());
                     *hit = trace_ray::<K, _, T, _>(method, &self.mem, self.root, ray, query, &mut obs);
                     counters = obs.0;
-                    *nodes = obs.1.nodes.iter().map(|&r| self.layout.canonical_id(r).unwrap_or(u32::MAX)).collect();
+                    *nodes = self.scene.canonical_ids(Method::Bvh2(method), obs.1.nodes.iter().copied())?;
                 }
             }
         }
         counters.rays = chunk.rays.len() as u64;
-        counters
+        Ok(counters)
     }
 }

@@ -1,11 +1,10 @@
-use super::{
-    trace_pausing, Fallback, Method, ParentSiblingState, PerfectHashLookup, Query, QueryState, RegisterState,
-    StackState, Step, UncleHops,
-};
+use super::{trace_pausing, Fallback, ParentSiblingState, PerfectHashLookup, RegisterState, StackState, UncleHops};
 use crate::bvh2::{BvhMemory, NodeRef};
-use crate::intersect::{BoxConstants, RayContext, SlabPair, SlabRay, TriangleTest};
+use crate::intersect::{RayContext, SlabPair, TriangleTest};
 use crate::key::Key;
+use crate::method::{Bvh2Method, Query};
 use crate::observe::Observer;
+use crate::traverse::{begin, QueryState, Step};
 use crate::{Hit, Ray};
 
 /// Where a traversal starts, with the scene constant every ray needs.
@@ -20,38 +19,14 @@ pub struct TraceRoot {
     pub max_steps: u32,
 }
 
-/// The per-ray constants and an empty answer, or `None` for a ray every method treats as a miss
-/// (not traceable, or with distances that overflow: [`RayContext::is_reliable`]).
-#[inline(always)]
-pub fn begin<T: TriangleTest, B: BoxConstants>(
-    ray: &Ray,
-    scene_scale: f32,
-    query: Query,
-) -> Option<(RayContext<T, B>, QueryState)> {
-    let slab = begin_slab(ray, scene_scale)?;
-    Some((RayContext::from_slab(ray, slab), QueryState::new(ray, query == Query::Any)))
-}
-
-/// The first stage of [`begin`]: the slab constants with their slack, or `None` where `begin`
-/// turns the ray away. A traversal that tests one box first (the kd-tree's scene box) makes the
-/// rest of the context only for rays that enter it.
-#[inline(always)]
-pub fn begin_slab(ray: &Ray, scene_scale: f32) -> Option<SlabRay> {
-    if !ray.is_traceable() {
-        return None;
-    }
-    let slab = SlabRay::with_slack(ray, scene_scale);
-    slab.slack.is_finite().then_some(slab)
-}
-
 /// Traces one ray with `method` over `mem` (which must hold what the method needs: the
-/// parent/sibling layout for [`Method::ParentSibling`], the uncle layout otherwise, and the hash
+/// parent/sibling layout for [`Bvh2Method::ParentSibling`], the uncle layout otherwise, and the hash
 /// tables for the hash methods). `K` is the key and trail type the tree's depth needs.
 ///
 /// A ray that is not traceable ([`Ray::is_traceable`]) is a miss and visits nothing.
 #[inline]
 pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-    method: Method,
+    method: Bvh2Method,
     mem: &M,
     root: TraceRoot,
     ray: &Ray,
@@ -76,7 +51,7 @@ pub fn trace_ray<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
 /// once per ray (the CPU backend's hot loop).
 #[inline]
 pub fn trace_batch<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-    method: Method,
+    method: Bvh2Method,
     mem: &M,
     root: TraceRoot,
     rays: &[Ray],
@@ -86,37 +61,35 @@ pub fn trace_batch<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
 ) {
     let r = root.node;
     match method {
-        Method::Stack => {
+        Bvh2Method::Stack => {
             let mut s = StackState::<false>::new(r);
             for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
                 s.restart(r);
                 drive(&mut s, mem, ctx, q, obs, root.max_steps);
             });
         }
-        Method::StackDisjoint => {
+        Bvh2Method::StackDisjoint => {
             let mut s = StackState::<true>::new(r);
             for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
                 s.restart(r);
                 drive(&mut s, mem, ctx, q, obs, root.max_steps);
             });
         }
-        Method::ParentSibling => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+        Bvh2Method::ParentSibling => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
             drive(&mut ParentSiblingState::<K>::new(r), mem, ctx, q, obs, root.max_steps)
         }),
-        Method::Uncle => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+        Bvh2Method::Uncle => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
             drive(&mut RegisterState::<K, UncleHops, false>::new(r), mem, ctx, q, obs, root.max_steps)
         }),
-        Method::Hash => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+        Bvh2Method::Hash => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
             drive(&mut RegisterState::<K, PerfectHashLookup, false>::new(r), mem, ctx, q, obs, root.max_steps)
         }),
-        Method::HashDisjoint => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+        Bvh2Method::HashDisjoint => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
             drive(&mut RegisterState::<K, PerfectHashLookup, true>::new(r), mem, ctx, q, obs, root.max_steps)
         }),
-        Method::HashResume => {
+        Bvh2Method::HashResume => {
             for_each_ray::<T>(rays, hits, root, query, |ctx, q| trace_pausing::<K, M, T, O>(mem, root, ctx, q, obs))
         }
-        // kd-tree methods run through `kd::traverse`; given BVH2 memory they find nothing.
-        _ => hits.iter_mut().for_each(|h| *h = Hit::MISS),
     }
 }
 

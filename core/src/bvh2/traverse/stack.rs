@@ -1,7 +1,8 @@
-use super::{intersect_leaf, order_children, Descent, QueryState, Step};
+use super::{intersect_leaf, order_children, Descent};
 use crate::bvh2::{BvhMemory, NodeRef};
 use crate::intersect::{RayContext, TriangleTest};
 use crate::observe::{Backtrack, Observer};
+use crate::traverse::{QueryState, Step};
 
 /// Deepest stack needed: one entry per level of a tree of depth 63.
 const CAPACITY: usize = 64;

@@ -1,8 +1,9 @@
-use super::{intersect_leaf, order_children, Descent, QueryState, Step};
+use super::{intersect_leaf, order_children, Descent};
 use crate::bvh2::{BvhMemory, NodeRef};
 use crate::intersect::{RayContext, TriangleTest};
 use crate::key::Key;
 use crate::observe::{Backtrack, Observer};
+use crate::traverse::{QueryState, Step};
 
 /// Method (b): stackless traversal with parent and sibling links and a bit trail (Áfra, Szirmay-
 /// Kalos and Keller 2014). Backtracking climbs parent links until the trail shows a postponed

@@ -1,10 +1,11 @@
 use super::TraceRoot;
-use super::{PerfectHashLookup, QueryState, RegisterState, Step};
+use super::{PerfectHashLookup, RegisterState};
 use crate::bvh2::BvhMemory;
 use crate::hash::lookup;
 use crate::intersect::{RayContext, TriangleTest};
 use crate::key::{self, Key};
 use crate::observe::Observer;
+use crate::traverse::{QueryState, Step};
 
 /// A paused traversal (Sec. 2.4): the key of the next node and the bit trail. The register need
 /// not be saved, because the backtracking step is made before pausing; the address comes back

@@ -1,0 +1,125 @@
+//! The serial reference backend: every ray on the calling thread, through the core's per-ray
+//! entry points and nothing else. It is the suite's yardstick for other backends (each is compared
+//! with it ray by ray), and the smallest example of a backend.
+
+use raytrail_core::bvh2::traverse::trace_ray;
+use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
+use raytrail_core::kd::traverse::packets::packets;
+use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, RestartPolicy, PACKET_WIDTH};
+use raytrail_core::key::KeyWidth;
+use raytrail_core::method::{KdMethod, Method};
+use raytrail_core::observe::{Both, Counters, Recorder};
+use raytrail_core::prepared::PreparedScene;
+use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
+use raytrail_core::{Error, Hit, Ray};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Traces one ray at a time with the core's state machines, always observing, and keeps what
+/// the options ask for.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SerialBackend;
+
+/// What one ray left: its hit and its observer.
+type Traced = (Hit, Both<Counters, Recorder>);
+
+impl SerialBackend {
+    fn trace_all<T: TriangleTest>(
+        scene: &PreparedScene,
+        method: Method,
+        opts: &TraceOptions,
+        rays: &[Ray],
+    ) -> Result<Vec<Traced>, Error> {
+        let query = opts.query;
+        let fresh = || Both(Counters::default(), Recorder::default());
+        match method {
+            Method::Bvh2(m) => {
+                let (mem, root) = (scene.memory(m)?, scene.root(m)?);
+                Ok(rays
+                    .iter()
+                    .map(|ray| {
+                        let mut o = fresh();
+                        let hit = match scene.key_width() {
+                            KeyWidth::W32 => trace_ray::<u32, _, T, _>(m, &mem, root, ray, query, &mut o),
+                            KeyWidth::W64 => trace_ray::<u64, _, T, _>(m, &mem, root, ray, query, &mut o),
+                        };
+                        (hit, o)
+                    })
+                    .collect())
+            }
+            Method::Kd(KdMethod::Packet) => {
+                let (mem, root) = (scene.kd_memory()?, scene.kd_root()?);
+                let mut out: Vec<Traced> = (0..rays.len()).map(|_| (Hit::MISS, fresh())).collect();
+                let policy = RestartPolicy::short_stack(root.short_stack);
+                for idx in packets(rays) {
+                    let packet: Vec<Ray> = idx.iter().map(|&i| rays[i as usize]).collect();
+                    let mut hits = [Hit::MISS; PACKET_WIDTH];
+                    let mut obs: [Both<Counters, Recorder>; PACKET_WIDTH] = Default::default();
+                    trace_kd_packet::<PACKET_WIDTH, _, T, _>(&mem, &root, &packet, query, policy, &mut hits, &mut obs);
+                    for ((&i, hit), o) in idx.iter().zip(hits).zip(obs) {
+                        out[i as usize] = (hit, o);
+                    }
+                }
+                Ok(out)
+            }
+            Method::Kd(m) => {
+                let (mem, root) = (scene.kd_memory()?, scene.kd_root()?);
+                Ok(rays
+                    .iter()
+                    .map(|ray| {
+                        let mut o = fresh();
+                        (trace_kd_ray::<_, T, _>(m, &mem, &root, ray, query, &mut o), o)
+                    })
+                    .collect())
+            }
+            other => Err(Error::Unsupported { method: other.name(), by: "the serial reference backend" }),
+        }
+    }
+}
+
+impl Trace for SerialBackend {
+    type Prepared = Arc<PreparedScene>;
+
+    fn name(&self) -> &str {
+        "serial"
+    }
+
+    /// Every BVH2 and kd method.
+    fn supports(&self, method: Method) -> bool {
+        matches!(method, Method::Bvh2(_) | Method::Kd(_))
+    }
+
+    fn prepare(&self, scene: Arc<PreparedScene>) -> Result<Arc<PreparedScene>, Error> {
+        Ok(scene)
+    }
+
+    fn trace(
+        &self,
+        scene: &Arc<PreparedScene>,
+        rays: &[Ray],
+        opts: &TraceOptions,
+        hits: &mut [Hit],
+    ) -> Result<Report, Error> {
+        check_buffers(rays, hits)?;
+        scene.check_prepared(opts.method)?;
+        let start = Instant::now();
+        let traced = match opts.triangle_test {
+            TriangleTestKind::Watertight => Self::trace_all::<Watertight>(scene, opts.method, opts, rays)?,
+            TriangleTestKind::MollerTrumbore => Self::trace_all::<MollerTrumbore>(scene, opts.method, opts, rays)?,
+        };
+        let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());
+        let mut counters = Counters::default();
+        let mut enumerations = Vec::new();
+        for ((hit, o), slot) in traced.into_iter().zip(hits.iter_mut()) {
+            *slot = hit;
+            counters.add(&o.0);
+            if opts.record == Record::Enumerations {
+                enumerations.push(scene.canonical_ids(opts.method, o.1.nodes)?);
+            }
+        }
+        counters.rays = rays.len() as u64;
+        report.counters = (opts.record != Record::Nothing).then_some(counters);
+        report.enumerations = (opts.record == Record::Enumerations).then_some(enumerations);
+        Ok(report)
+    }
+}

@@ -1,0 +1,242 @@
+//! The conformance suite as a library: every scene × ray set × method × query check, for any
+//! backend. A backend opts in from one of its test files with one line,
+//! `raytrail_conformance::conformance_suite!(MyBackend::new());` (or `try MyBackend::new()` for a
+//! constructor that can fail, such as a GPU's), which defines one test per [`Case`].
+//!
+//! Each case builds its trees, makes the ray sets, and checks on the backend every method against
+//! its reference method ([`compare`](crate::check::compare)) and every outcome ray by ray against
+//! the [`SerialBackend`] ([`compare_backends`](crate::check::compare_backends)). A method the
+//! backend does not support fails the case: the suite never passes over a method in silence.
+
+use crate::check::{check_against, Context, Mismatch};
+use crate::paths::{load_mesh_scene, scenes_dir};
+use crate::rays::{ray_sets, RaySetSize};
+use crate::reference::SerialBackend;
+use crate::scenes::{generated, tiny_cases, NamedScene};
+use raytrail_core::bvh2::{Bvh2, SahBuilder};
+use raytrail_core::key::KeyWidth;
+use raytrail_core::method::{Bvh2Method, Method};
+use raytrail_core::prepared::PreparedScene;
+use raytrail_core::trace::{Trace, TraceOptions};
+use raytrail_core::{Hit, Ray};
+use std::any::Any;
+use std::fmt::Display;
+use std::sync::{Arc, OnceLock};
+
+/// Set to 1 to let the mesh cases pass without the scenes folder (they then print why).
+pub const ALLOW_MISSING: &str = "RAYTRAIL_ALLOW_MISSING_SCENES";
+
+/// Set to 1 to make a backend whose constructor fails (no GPU adapter) fail the suite instead of
+/// skipping it (CI sets it, with a software Vulkan driver installed).
+pub const REQUIRE_GPU: &str = "RAYTRAIL_REQUIRE_GPU";
+
+/// Ray set sizes for the meshes.
+pub const MESH_RAYS: RaySetSize = RaySetSize { width: 64, height: 48, uniform_count: 4096 };
+/// Ray set sizes for the generated scenes.
+pub const GENERATED_RAYS: RaySetSize = RaySetSize { width: 96, height: 72, uniform_count: 8192 };
+/// Ray set sizes for the tiny cases.
+pub const TINY_RAYS: RaySetSize = RaySetSize { width: 16, height: 16, uniform_count: 512 };
+
+/// One test of the suite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Case {
+    /// A grid of triangles sharing edges (SAH tree).
+    SharedEdgeGrid,
+    /// The sphereflake, with SAH and PLOC trees.
+    Sphereflake,
+    /// A random triangle soup, with SAH and PLOC trees.
+    TriangleSoup,
+    /// A stack of triangles deep enough to need 64-bit keys.
+    DegenerateStack,
+    /// A scene far from the origin.
+    FarFromOrigin,
+    /// The tiny hand-made cases.
+    TinyCases,
+    /// A mesh of the scenes folder with a SAH tree (the file name).
+    Mesh(&'static str),
+    /// A mesh of the scenes folder with a PLOC tree.
+    MeshPloc(&'static str),
+}
+
+/// Runs one case on `backend`; panics with a loud report on any mismatch.
+pub fn run_case<B: Trace>(backend: &B, case: Case) {
+    let sah = |s: &NamedScene| SahBuilder::default().build(s.scene.triangles()).expect("SAH build");
+    let ploc = |s: &NamedScene| raytrail_cpu::ploc::build_ploc(s.scene.triangles(), 63).expect("PLOC build");
+    match case {
+        Case::SharedEdgeGrid => check_scene(backend, &generated_scene("shared_edge_grid"), sah, GENERATED_RAYS),
+        Case::Sphereflake | Case::TriangleSoup => {
+            let s = generated_scene(if case == Case::Sphereflake { "sphereflake" } else { "triangle_soup" });
+            check_scene(backend, &s, sah, GENERATED_RAYS);
+            check_scene(backend, &s, ploc, GENERATED_RAYS);
+        }
+        Case::DegenerateStack => {
+            let s = generated_scene("degenerate_stack");
+            let bvh = sah(&s);
+            assert_eq!(bvh.stats().key_width, KeyWidth::W64, "depth {} should need 64-bit keys", bvh.stats().depth);
+            check_scene(backend, &s, |_| bvh.clone(), GENERATED_RAYS);
+        }
+        Case::FarFromOrigin => check_scene(backend, &generated_scene("far_from_origin"), sah, GENERATED_RAYS),
+        Case::TinyCases => {
+            for s in tiny_cases() {
+                check_scene(backend, &s, sah, TINY_RAYS);
+            }
+        }
+        Case::Mesh(file) => {
+            if let Some(s) = mesh(file) {
+                check_scene(backend, &s, sah, MESH_RAYS);
+            }
+        }
+        Case::MeshPloc(file) => {
+            if let Some(s) = mesh(file) {
+                check_scene(backend, &s, ploc, MESH_RAYS);
+            }
+        }
+    }
+}
+
+/// Runs one case on the backend `make` builds, once per test binary: a backend whose
+/// constructor fails is skipped with its reason printed, or fails when [`REQUIRE_GPU`] is 1.
+pub fn run_case_or_skip<B: Trace + 'static, E: Display>(make: impl FnOnce() -> Result<B, E>, case: Case) {
+    // One backend for the whole binary (a device and its compiled kernels are costly to make).
+    static BACKEND: OnceLock<Result<Box<dyn Any + Send + Sync>, String>> = OnceLock::new();
+    let made =
+        BACKEND.get_or_init(|| make().map(|b| Box::new(b) as Box<dyn Any + Send + Sync>).map_err(|e| e.to_string()));
+    match made {
+        Ok(b) => match b.downcast_ref::<B>() {
+            Some(b) => run_case(b, case),
+            None => panic!("one test binary opted into the suite with two backend types"),
+        },
+        Err(e) if std::env::var(REQUIRE_GPU).as_deref() == Ok("1") => {
+            panic!("{REQUIRE_GPU}=1 but the backend is unavailable: {e}")
+        }
+        Err(e) => {
+            static SAID: std::sync::Once = std::sync::Once::new();
+            SAID.call_once(|| {
+                eprintln!("SKIPPED the conformance suite: {e} (set {REQUIRE_GPU}=1 to make this a failure)")
+            });
+            eprintln!("SKIPPED {case:?}");
+        }
+    }
+}
+
+/// A generated scene by name.
+pub fn generated_scene(name: &str) -> NamedScene {
+    generated().into_iter().find(|s| s.name == name).unwrap_or_else(|| panic!("no generated scene {name}"))
+}
+
+/// Loads a mesh of the suite; a missing scenes folder fails unless [`ALLOW_MISSING`] is 1.
+pub fn mesh(file: &str) -> Option<NamedScene> {
+    match load_mesh_scene(file) {
+        Ok(s) => Some(s),
+        Err(e) if std::env::var(ALLOW_MISSING).as_deref() == Ok("1") => {
+            eprintln!("SKIPPED {file}: {e} ({ALLOW_MISSING}=1)");
+            None
+        }
+        Err(e) => panic!(
+            "{e}\n(scenes are read from {}; set RAYTRAIL_SCENES or run the fetch script)",
+            scenes_dir().display()
+        ),
+    }
+}
+
+/// Runs every method for both queries on every ray set of `named`, with the tree `build` makes,
+/// on `backend`, against each method's reference and against the serial backend; panics with the
+/// first mismatches if there are any, or if the backend does not support a method.
+pub fn check_scene<B: Trace>(
+    backend: &B,
+    named: &NamedScene,
+    build: impl FnOnce(&NamedScene) -> Bvh2,
+    size: RaySetSize,
+) {
+    let unsupported: Vec<Method> = Method::ALL.into_iter().filter(|&m| !backend.supports(m)).collect();
+    assert!(
+        unsupported.is_empty(),
+        "NOT CONFORMING: backend {} does not support {:?}; every backend must run every method",
+        backend.name(),
+        unsupported.iter().map(|m| m.name()).collect::<Vec<_>>()
+    );
+    let prepared = Arc::new(PreparedScene::new(&named.scene, build(named), &Method::ALL).expect("prepare"));
+    let serial = SerialBackend;
+    let serial_scene = serial.prepare(prepared.clone()).expect("prepare on the serial backend");
+    let scene = backend.prepare(prepared).expect("prepare on the backend");
+    let mut trace_closest = |rays: &[Ray]| {
+        let mut hits = vec![Hit::MISS; rays.len()];
+        serial.trace(&serial_scene, rays, &TraceOptions::new(Bvh2Method::Stack), &mut hits).expect("trace");
+        hits
+    };
+    let sets = ray_sets(&named.scene, size, &mut trace_closest);
+    let mut mismatches: Vec<Mismatch> = Vec::new();
+    let mut checked = 0;
+    for set in &sets {
+        let ctx = Context { scene: &named.name, ray_set: set.kind.name(), backend: backend.name() };
+        mismatches.extend(
+            check_against(&serial, &serial_scene, backend, &scene, ctx, &set.rays, &Method::ALL).expect("trace"),
+        );
+        checked += set.rays.len();
+    }
+    assert!(checked > 0, "{}: no rays were checked", named.name);
+    if !mismatches.is_empty() {
+        panic!("{}", mismatch_report(&named.name, backend.name(), checked, &mismatches));
+    }
+    eprintln!(
+        "{}: {} rays x {} methods x 2 queries conform on {} and match the serial backend",
+        named.name,
+        checked,
+        Method::ALL.len(),
+        backend.name()
+    );
+}
+
+/// The loud failure message: how many mismatches, where, and the first ones in full.
+pub fn mismatch_report(scene: &str, backend: &str, checked: usize, mismatches: &[Mismatch]) -> String {
+    let mut msg = format!(
+        "\n{} MISMATCHES in scene {scene} on {backend} ({checked} rays x {} methods x 2 queries checked). First ones:\n",
+        mismatches.len(),
+        Method::ALL.len()
+    );
+    for m in mismatches.iter().take(6) {
+        msg.push_str(&m.to_string());
+    }
+    msg
+}
+
+/// Defines one `#[test]` per [`Case`] of the suite for a backend:
+/// `conformance_suite!(CpuBackend::new());`, or with `try` for a constructor returning a
+/// `Result` (the backend is then made once per test binary, and skipped if it cannot be made
+/// unless [`REQUIRE_GPU`] is 1).
+#[macro_export]
+macro_rules! conformance_suite {
+    (try $make:expr) => {
+        $crate::conformance_suite!(@cases |case| $crate::suite::run_case_or_skip(|| $make, case));
+    };
+    ($make:expr) => {
+        $crate::conformance_suite!(@cases |case| $crate::suite::run_case(&$make, case));
+    };
+    (@cases $run:expr) => {
+        $crate::conformance_suite!(@each $run;
+            shared_edge_grid => SharedEdgeGrid,
+            sphereflake => Sphereflake,
+            triangle_soup => TriangleSoup,
+            degenerate_stack_needs_and_uses_64_bit_keys => DegenerateStack,
+            far_from_origin => FarFromOrigin,
+            tiny_cases => TinyCases,
+            cornell_box => Mesh("cornell_box.obj"),
+            teapot => Mesh("teapot.obj"),
+            kitchen => Mesh("kitchen.obj"),
+            sponza => Mesh("sponza.obj"),
+            bunny => Mesh("bunny.obj"),
+            dragon_res2 => Mesh("dragon_vrip_res2.ply.gz"),
+            dragon_full => Mesh("dragon_vrip.ply.gz"),
+            bunny_with_ploc => MeshPloc("bunny.obj"),
+        );
+    };
+    (@each $run:expr; $($name:ident => $case:ident $(($file:expr))?,)*) => {
+        $(
+            #[test]
+            fn $name() {
+                let run: fn($crate::suite::Case) = $run;
+                run($crate::suite::Case::$case $(($file))?);
+            }
+        )*
+    };
+}

@@ -1,0 +1,215 @@
+//! Which traversal to run, grouped by the structure it traverses.
+//!
+//! Each structure has its own method enum ([`Bvh2Method`], [`KdMethod`]) and its entry points take
+//! that enum, so a kd method cannot be handed to a BVH2 traversal: it does not compile. [`Method`]
+//! names any method, for backends, reports and the command line; turning it into a structure's
+//! method at run time ([`Bvh2Method::try_from`]) fails with [`Error::Unsupported`] rather than
+//! tracing nothing.
+
+mod bvh2;
+mod kd;
+mod query;
+
+pub use bvh2::Bvh2Method;
+pub use kd::KdMethod;
+pub use query::Query;
+
+use crate::Error;
+use core::fmt;
+
+/// Any traversal method, by the structure it traverses. New structures (the wide BVH, the ray
+/// stream) add variants, hence `non_exhaustive`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[non_exhaustive]
+pub enum Method {
+    /// A method of the binary BVH.
+    Bvh2(Bvh2Method),
+    /// A method of the kd-tree.
+    Kd(KdMethod),
+}
+
+/// The acceleration structure a method traverses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Structure {
+    /// The binary BVH.
+    Bvh2,
+    /// The kd-tree.
+    Kd,
+}
+
+impl Method {
+    /// Every method: the BVH2 methods, then the kd methods.
+    pub const ALL: [Method; 12] = [
+        Method::Bvh2(Bvh2Method::Stack),
+        Method::Bvh2(Bvh2Method::StackDisjoint),
+        Method::Bvh2(Bvh2Method::ParentSibling),
+        Method::Bvh2(Bvh2Method::Uncle),
+        Method::Bvh2(Bvh2Method::Hash),
+        Method::Bvh2(Bvh2Method::HashDisjoint),
+        Method::Bvh2(Bvh2Method::HashResume),
+        Method::Kd(KdMethod::Stack),
+        Method::Kd(KdMethod::Restart),
+        Method::Kd(KdMethod::PushDown),
+        Method::Kd(KdMethod::ShortStack),
+        Method::Kd(KdMethod::Packet),
+    ];
+
+    /// The BVH2 methods, as [`Method`]s.
+    pub const BVH2: [Method; 7] = [
+        Method::Bvh2(Bvh2Method::Stack),
+        Method::Bvh2(Bvh2Method::StackDisjoint),
+        Method::Bvh2(Bvh2Method::ParentSibling),
+        Method::Bvh2(Bvh2Method::Uncle),
+        Method::Bvh2(Bvh2Method::Hash),
+        Method::Bvh2(Bvh2Method::HashDisjoint),
+        Method::Bvh2(Bvh2Method::HashResume),
+    ];
+
+    /// The kd-tree methods, as [`Method`]s.
+    pub const KD: [Method; 5] = [
+        Method::Kd(KdMethod::Stack),
+        Method::Kd(KdMethod::Restart),
+        Method::Kd(KdMethod::PushDown),
+        Method::Kd(KdMethod::ShortStack),
+        Method::Kd(KdMethod::Packet),
+    ];
+
+    /// The structure the method traverses.
+    pub fn structure(self) -> Structure {
+        match self {
+            Method::Bvh2(_) => Structure::Bvh2,
+            Method::Kd(_) => Structure::Kd,
+        }
+    }
+
+    /// Command-line name (unique over every method).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Bvh2(m) => m.name(),
+            Method::Kd(m) => m.name(),
+        }
+    }
+
+    /// The method of a command-line name.
+    pub fn from_name(name: &str) -> Option<Method> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// The method whose node enumeration this one must equal, closest hit and any hit alike
+    /// (for kd methods the enumeration is the sequence of leaves: restarts revisit inner nodes).
+    pub fn reference(self) -> Method {
+        match self {
+            Method::Bvh2(m) => Method::Bvh2(m.reference()),
+            Method::Kd(_) => Method::Kd(KdMethod::Stack),
+        }
+    }
+
+    /// Per-ray traversal state in bytes, beyond the ray and its answer: the registers the paper
+    /// names, for a tree of the given depth and key width in bytes, as a hardware unit or a
+    /// shader sized for this tree would hold them. (The Rust state types are larger: the stack
+    /// is fixed at 64 entries so one type serves every tree.)
+    pub fn state_bytes(self, depth: u32, key_bytes: usize) -> usize {
+        match self {
+            Method::Bvh2(m) => m.state_bytes(depth, key_bytes),
+            Method::Kd(m) => m.state_bytes(depth),
+        }
+    }
+
+    /// The BVH2 method, if this is one.
+    pub fn bvh2(self) -> Option<Bvh2Method> {
+        match self {
+            Method::Bvh2(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The kd method, if this is one.
+    pub fn kd(self) -> Option<KdMethod> {
+        match self {
+            Method::Kd(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// Whether the method needs the perfect hash over backtracking targets.
+    pub fn needs_hash(self) -> bool {
+        self.bvh2().is_some_and(Bvh2Method::needs_hash)
+    }
+
+    /// Whether the method needs the hash over every node (resuming from any key).
+    pub fn needs_full_hash(self) -> bool {
+        self.bvh2().is_some_and(Bvh2Method::needs_full_hash)
+    }
+
+    /// Whether the method needs the parent/sibling layout rather than the uncle layout.
+    pub fn needs_parent_links(self) -> bool {
+        self.bvh2().is_some_and(Bvh2Method::needs_parent_links)
+    }
+}
+
+impl From<Bvh2Method> for Method {
+    fn from(m: Bvh2Method) -> Method {
+        Method::Bvh2(m)
+    }
+}
+
+impl From<KdMethod> for Method {
+    fn from(m: KdMethod) -> Method {
+        Method::Kd(m)
+    }
+}
+
+impl TryFrom<Method> for Bvh2Method {
+    type Error = Error;
+    /// The BVH2 method, or [`Error::Unsupported`] naming a method of another structure.
+    fn try_from(m: Method) -> Result<Bvh2Method, Error> {
+        m.bvh2().ok_or(Error::Unsupported { method: m.name(), by: "a BVH2 traversal" })
+    }
+}
+
+impl TryFrom<Method> for KdMethod {
+    type Error = Error;
+    /// The kd method, or [`Error::Unsupported`] naming a method of another structure.
+    fn try_from(m: Method) -> Result<KdMethod, Error> {
+        m.kd().ok_or(Error::Unsupported { method: m.name(), by: "a kd-tree traversal" })
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_round_trip() {
+        for m in Method::ALL {
+            assert_eq!(Method::from_name(m.name()), Some(m));
+        }
+        assert_eq!(Method::from_name("nope"), None);
+        assert_eq!(Method::BVH2.len() + Method::KD.len(), Method::ALL.len());
+    }
+
+    #[test]
+    fn a_method_of_another_structure_is_rejected_with_a_typed_error() {
+        let kd = Method::Kd(KdMethod::Stack);
+        assert_eq!(Bvh2Method::try_from(kd), Err(Error::Unsupported { method: "kd-stack", by: "a BVH2 traversal" }));
+        assert_eq!(
+            KdMethod::try_from(Method::Bvh2(Bvh2Method::Hash)),
+            Err(Error::Unsupported { method: "hash", by: "a kd-tree traversal" })
+        );
+        assert_eq!(Bvh2Method::try_from(Method::Bvh2(Bvh2Method::Uncle)), Ok(Bvh2Method::Uncle));
+    }
+
+    #[test]
+    fn references_stay_within_their_structure() {
+        for m in Method::ALL {
+            assert_eq!(m.reference().structure(), m.structure(), "{m}");
+        }
+    }
+}

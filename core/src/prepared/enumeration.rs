@@ -1,0 +1,27 @@
+//! The one convention for naming what a traversal visited, whatever backend recorded it.
+
+use super::PreparedScene;
+use crate::bvh2::NodeRef;
+use crate::method::Method;
+use crate::Error;
+use alloc::vec::Vec;
+
+/// The id [`PreparedScene::canonical_ids`] gives a recorded reference that names no node of the
+/// tree (only damaged tables produce one).
+pub const UNKNOWN_NODE: u32 = u32::MAX;
+
+impl PreparedScene {
+    /// Canonical ids of one ray's recorded node references, in visiting order: for BVH2 methods
+    /// the node's index in the canonical tree, whatever layout was traversed; for kd methods the
+    /// leaves alone, by index (restarting methods revisit inner nodes, so the leaf sequence is
+    /// what all kd methods share). Every backend turns its recordings into enumerations here.
+    pub fn canonical_ids(&self, method: Method, refs: impl IntoIterator<Item = NodeRef>) -> Result<Vec<u32>, Error> {
+        match method {
+            Method::Bvh2(m) => {
+                let layout = self.layout(m)?;
+                Ok(refs.into_iter().map(|r| layout.canonical_id(r).unwrap_or(UNKNOWN_NODE)).collect())
+            }
+            Method::Kd(_) => Ok(refs.into_iter().filter(|r| r.is_leaf()).map(|r| r.offset()).collect()),
+        }
+    }
+}
