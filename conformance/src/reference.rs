@@ -7,10 +7,12 @@ use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use raytrail_core::kd::traverse::packets::packets;
 use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, RestartPolicy, PACKET_WIDTH};
 use raytrail_core::key::KeyWidth;
-use raytrail_core::method::{KdMethod, Method};
+use raytrail_core::method::{KdMethod, Method, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
+use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
+use raytrail_core::wide::{ReferenceKernel, WideBvh, WideSliceMemory};
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 use std::time::Instant;
@@ -72,8 +74,37 @@ impl SerialBackend {
                     })
                     .collect())
             }
+            Method::Wide(m) => {
+                let root = scene.wide_root(m)?;
+                match m.width() {
+                    4 => Ok(Self::wide::<_, T>(&Self::wide_memory(scene.wide4(m)?), root, rays, query)),
+                    _ => Ok(Self::wide::<_, T>(&Self::wide_memory(scene.wide8(m)?), root, rays, query)),
+                }
+            }
             other => Err(Error::Unsupported { method: other.name(), by: "the serial reference backend" }),
         }
+    }
+}
+
+impl SerialBackend {
+    fn wide_memory<const W: usize>(tree: &WideBvh<W>) -> WideSliceMemory<'_, W> {
+        WideSliceMemory { nodes: tree.nodes(), triangles: tree.triangles(), prims: tree.prims() }
+    }
+
+    /// Wide trees with the reference kernel (one child box at a time, an insertion sort): the
+    /// scalar traversal every fast path's enumeration must equal.
+    fn wide<const W: usize, T: TriangleTest>(
+        mem: &WideSliceMemory<'_, W>,
+        root: WideRoot,
+        rays: &[Ray],
+        query: Query,
+    ) -> Vec<Traced> {
+        rays.iter()
+            .map(|ray| {
+                let mut o = Both(Counters::default(), Recorder::default());
+                (trace_wide_ray::<W, _, T, ReferenceKernel, _>(mem, root, ray, query, &mut o), o)
+            })
+            .collect()
     }
 }
 
@@ -84,9 +115,9 @@ impl Trace for SerialBackend {
         "serial"
     }
 
-    /// Every BVH2 and kd method.
+    /// Every BVH2, kd and wide-BVH method.
     fn supports(&self, method: Method) -> bool {
-        matches!(method, Method::Bvh2(_) | Method::Kd(_))
+        matches!(method, Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_))
     }
 
     fn prepare(&self, scene: Arc<PreparedScene>) -> Result<Arc<PreparedScene>, Error> {

@@ -33,9 +33,10 @@ pub mod scene;
 #[cfg(feature = "alloc")]
 pub mod trace;
 pub mod traverse;
+pub mod wide;
 
 pub use error::Error;
 pub use geometry::{Aabb, Hit, Ray};
 /// The vector library of the public API, re-exported so callers use the same version.
 pub use glam;
-pub use method::{Bvh2Method, KdMethod, Method, Query};
+pub use method::{Bvh2Method, KdMethod, Method, Query, WideMethod};

@@ -54,9 +54,9 @@ impl Trace for CpuBackend {
         "cpu"
     }
 
-    /// Every BVH2 and kd method.
+    /// Every BVH2, kd and wide-BVH method.
     fn supports(&self, method: Method) -> bool {
-        matches!(method, Method::Bvh2(_) | Method::Kd(_))
+        matches!(method, Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_))
     }
 
     fn prepare(&self, scene: Arc<PreparedScene>) -> Result<CpuScene, Error> {
@@ -105,6 +105,7 @@ fn trace_chunk(scene: &PreparedScene, opts: &TraceOptions, chunk: Chunk<'_>) -> 
     match opts.method {
         Method::Bvh2(m) => crate::bvh2::trace_chunk(scene, m, opts, chunk),
         Method::Kd(m) => crate::kd::trace_chunk(scene, m, opts, chunk),
+        Method::Wide(m) => crate::wide::trace_chunk(scene, m, opts, chunk),
         other => Err(Error::Unsupported { method: other.name(), by: "the CPU backend" }),
     }
 }

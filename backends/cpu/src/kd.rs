@@ -3,7 +3,7 @@
 
 use crate::chunk::Chunk;
 use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
-use raytrail_core::kd::traverse::packets::packets;
+use raytrail_core::kd::traverse::packets::{packet_slots, PADDING};
 use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, KdRoot, RestartPolicy, PACKET_WIDTH};
 use raytrail_core::kd::KdSliceMemory;
 use raytrail_core::method::{KdMethod, Method};
@@ -82,14 +82,24 @@ impl KdRun<'_> {
             return Ok(());
         }
         let policy = RestartPolicy::short_stack(self.root.short_stack);
-        for idx in packets(rays) {
-            let packet: Vec<Ray> = idx.iter().map(|&i| rays[i as usize]).collect();
+        // The slots are read in place: a list per packet cost a fifth of a fast ray's time.
+        for slots in packet_slots(rays).chunks(PACKET_WIDTH) {
+            let n = slots.iter().take_while(|&&i| i != PADDING).count();
+            let packet: [Ray; PACKET_WIDTH] = core::array::from_fn(|k| rays[slots[k.min(n - 1)] as usize]);
             let mut out = [Hit::MISS; PACKET_WIDTH];
             let mut obs: [O; PACKET_WIDTH] = Default::default();
-            trace_kd_packet::<PACKET_WIDTH, _, T, O>(&self.mem, &self.root, &packet, query, policy, &mut out, &mut obs);
-            for (k, o) in obs.into_iter().enumerate().take(idx.len()) {
-                hits[idx[k] as usize] = out[k];
-                done(idx[k] as usize, o)?;
+            trace_kd_packet::<PACKET_WIDTH, _, T, O>(
+                &self.mem,
+                &self.root,
+                &packet[..n],
+                query,
+                policy,
+                &mut out,
+                &mut obs,
+            );
+            for (k, o) in obs.into_iter().enumerate().take(n) {
+                hits[slots[k] as usize] = out[k];
+                done(slots[k] as usize, o)?;
             }
         }
         Ok(())

@@ -13,5 +13,6 @@ mod bvh2;
 mod chunk;
 mod kd;
 pub mod ploc;
+mod wide;
 
 pub use backend::{CpuBackend, CpuScene};

@@ -8,7 +8,7 @@ mod moller_trumbore;
 mod slab;
 mod slab_pair;
 #[cfg(test)]
-mod test_values;
+pub(crate) mod test_values;
 mod watertight;
 
 pub use context::{BoxConstants, KdRayContext, NoPair, RayContext, RELIABLE_LIMIT, SLACK_SCALE, SLACK_ULPS};

@@ -9,10 +9,12 @@
 mod bvh2;
 mod kd;
 mod query;
+mod wide;
 
 pub use bvh2::Bvh2Method;
 pub use kd::KdMethod;
 pub use query::Query;
+pub use wide::{Collapse, WideMethod};
 
 use crate::Error;
 use core::fmt;
@@ -26,6 +28,8 @@ pub enum Method {
     Bvh2(Bvh2Method),
     /// A method of the kd-tree.
     Kd(KdMethod),
+    /// A method of a wide BVH.
+    Wide(WideMethod),
 }
 
 /// The acceleration structure a method traverses.
@@ -36,6 +40,8 @@ pub enum Structure {
     Bvh2,
     /// The kd-tree.
     Kd,
+    /// A wide BVH collapsed from the binary one.
+    Wide,
 }
 
 impl Method {
@@ -61,12 +67,30 @@ impl Method {
         out
     };
 
-    /// Every method: the BVH2 methods, then the kd methods.
-    pub const ALL: [Method; Method::BVH2.len() + Method::KD.len()] = {
-        let mut out = [Method::Bvh2(Bvh2Method::Stack); Method::BVH2.len() + Method::KD.len()];
+    /// The wide-BVH methods, as [`Method`]s.
+    pub const WIDE: [Method; WideMethod::ALL.len()] = {
+        let mut out = [Method::Wide(WideMethod::Bvh4); WideMethod::ALL.len()];
         let mut i = 0;
         while i < out.len() {
-            out[i] = if i < Method::BVH2.len() { Method::BVH2[i] } else { Method::KD[i - Method::BVH2.len()] };
+            out[i] = Method::Wide(WideMethod::ALL[i]);
+            i += 1;
+        }
+        out
+    };
+
+    /// Every method: the BVH2 methods, the kd methods, then the wide methods.
+    pub const ALL: [Method; Method::BVH2.len() + Method::KD.len() + Method::WIDE.len()] = {
+        let (b, k) = (Method::BVH2.len(), Method::KD.len());
+        let mut out = [Method::Bvh2(Bvh2Method::Stack); Method::BVH2.len() + Method::KD.len() + Method::WIDE.len()];
+        let mut i = 0;
+        while i < out.len() {
+            out[i] = if i < b {
+                Method::BVH2[i]
+            } else if i < b + k {
+                Method::KD[i - b]
+            } else {
+                Method::WIDE[i - b - k]
+            };
             i += 1;
         }
         out
@@ -77,6 +101,7 @@ impl Method {
         match self {
             Method::Bvh2(_) => Structure::Bvh2,
             Method::Kd(_) => Structure::Kd,
+            Method::Wide(_) => Structure::Wide,
         }
     }
 
@@ -85,6 +110,7 @@ impl Method {
         match self {
             Method::Bvh2(m) => m.name(),
             Method::Kd(m) => m.name(),
+            Method::Wide(m) => m.name(),
         }
     }
 
@@ -95,10 +121,13 @@ impl Method {
 
     /// The method whose node enumeration this one must equal, closest hit and any hit alike
     /// (for kd methods the enumeration is the sequence of leaves: restarts revisit inner nodes).
+    /// A wide method is its own reference: each tree is its own, and its enumeration is checked
+    /// against the scalar reference traversal of the same tree (the serial backend's) instead.
     pub fn reference(self) -> Method {
         match self {
             Method::Bvh2(m) => Method::Bvh2(m.reference()),
             Method::Kd(_) => Method::Kd(KdMethod::Stack),
+            Method::Wide(m) => Method::Wide(m),
         }
     }
 
@@ -110,6 +139,7 @@ impl Method {
         match self {
             Method::Bvh2(m) => m.state_bytes(depth, key_bytes),
             Method::Kd(m) => m.state_bytes(depth),
+            Method::Wide(m) => m.state_bytes(depth),
         }
     }
 
@@ -125,6 +155,14 @@ impl Method {
     pub fn kd(self) -> Option<KdMethod> {
         match self {
             Method::Kd(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The wide method, if this is one.
+    pub fn wide(self) -> Option<WideMethod> {
+        match self {
+            Method::Wide(m) => Some(m),
             _ => None,
         }
     }
@@ -165,6 +203,20 @@ impl TryFrom<Method> for Bvh2Method {
     }
 }
 
+impl From<WideMethod> for Method {
+    fn from(m: WideMethod) -> Method {
+        Method::Wide(m)
+    }
+}
+
+impl TryFrom<Method> for WideMethod {
+    type Error = Error;
+    /// The wide method, or [`Error::Unsupported`] naming a method of another structure.
+    fn try_from(m: Method) -> Result<WideMethod, Error> {
+        m.wide().ok_or(Error::Unsupported { method: m.name(), by: "a wide-BVH traversal" })
+    }
+}
+
 impl TryFrom<Method> for KdMethod {
     type Error = Error;
     /// The kd method, or [`Error::Unsupported`] naming a method of another structure.
@@ -189,7 +241,7 @@ mod tests {
             assert_eq!(Method::from_name(m.name()), Some(m));
         }
         assert_eq!(Method::from_name("nope"), None);
-        assert_eq!(Method::BVH2.len() + Method::KD.len(), Method::ALL.len());
+        assert_eq!(Method::BVH2.len() + Method::KD.len() + Method::WIDE.len(), Method::ALL.len());
         assert_eq!((Method::ALL[0], Method::ALL[7]), (Method::Bvh2(Bvh2Method::Stack), Method::Kd(KdMethod::Stack)));
     }
 

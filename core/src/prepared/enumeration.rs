@@ -14,7 +14,8 @@ impl PreparedScene {
     /// Canonical ids of one ray's recorded node references, in visiting order: for BVH2 methods
     /// the node's index in the canonical tree, whatever layout was traversed; for kd methods the
     /// leaves alone, by index (restarting methods revisit inner nodes, so the leaf sequence is
-    /// what all kd methods share). Every backend turns its recordings into enumerations here.
+    /// what all kd methods share); for wide methods the canonical id of the binary node each wide
+    /// node or leaf stands for. Every backend turns its recordings into enumerations here.
     pub fn canonical_ids(&self, method: Method, refs: impl IntoIterator<Item = NodeRef>) -> Result<Vec<u32>, Error> {
         match method {
             Method::Bvh2(m) => {
@@ -22,6 +23,17 @@ impl PreparedScene {
                 Ok(refs.into_iter().map(|r| layout.canonical_id(r).unwrap_or(UNKNOWN_NODE)).collect())
             }
             Method::Kd(_) => Ok(refs.into_iter().filter(|r| r.is_leaf()).map(|r| r.offset()).collect()),
+            // Wide nodes and leaves by the binary node each stands for.
+            Method::Wide(m) => {
+                let id = |r: NodeRef| -> Option<u32> {
+                    match m.width() {
+                        4 => self.wide4(m).ok()?.canonical_id(r),
+                        _ => self.wide8(m).ok()?.canonical_id(r),
+                    }
+                };
+                self.check_prepared(method)?;
+                Ok(refs.into_iter().map(|r| id(r).unwrap_or(UNKNOWN_NODE)).collect())
+            }
         }
     }
 }

@@ -10,8 +10,10 @@ use crate::hash::{keys_to_hash, HashCoverage, HashShape, HashStats, PerfectHash}
 use crate::kd::traverse::KdRoot;
 use crate::kd::{KdBuilder, KdSliceMemory, KdTree};
 use crate::key::KeyWidth;
-use crate::method::{Bvh2Method, Method, Structure};
+use crate::method::{Bvh2Method, Method, Structure, WideMethod};
 use crate::scene::Scene;
+use crate::wide::traverse::WideRoot;
+use crate::wide::WideBvh;
 use crate::Error;
 use alloc::vec::Vec;
 
@@ -26,6 +28,8 @@ pub struct PrepareTimings {
     pub full_hash: f64,
     /// The kd-tree.
     pub kd: f64,
+    /// The wide trees.
+    pub wide: f64,
 }
 
 /// A kd-tree with the triangles its leaves reference.
@@ -65,6 +69,12 @@ pub struct PreparedScene {
     pub full_hash: Option<BuiltHash>,
     /// The kd-tree (kd methods), built with [`KdBuilder::default`].
     pub kd: Option<PreparedKd>,
+    /// The 4-wide tree by Guthe's pull-up ([`WideMethod::Bvh4`]).
+    pub wide4: Option<WideBvh<4>>,
+    /// The 8-wide tree by the pull-up ([`WideMethod::Bvh8`]).
+    pub wide8: Option<WideBvh<8>>,
+    /// The 4-wide tree with every second level removed ([`WideMethod::Bvh4Naive`]).
+    pub wide4_naive: Option<WideBvh<4>>,
     /// Time spent on each part.
     pub timings: PrepareTimings,
 }
@@ -121,7 +131,17 @@ impl PreparedScene {
             None
         };
         timings.kd = seconds_since(Some(t3));
-        Ok(PreparedScene { bvh, uncles, parents, hash, full_hash, kd, timings })
+        let t4 = seconds_since(None);
+        let wants = |w: WideMethod| methods.contains(&Method::Wide(w));
+        let (wide4, wide8, wide4_naive) = (
+            wants(WideMethod::Bvh4).then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4.collapse())).transpose()?,
+            wants(WideMethod::Bvh8).then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse())).transpose()?,
+            wants(WideMethod::Bvh4Naive)
+                .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4Naive.collapse()))
+                .transpose()?,
+        );
+        timings.wide = seconds_since(Some(t4));
+        Ok(PreparedScene { bvh, uncles, parents, hash, full_hash, kd, wide4, wide8, wide4_naive, timings })
     }
 
     /// Key width the tree's depth needs.
@@ -188,12 +208,47 @@ impl PreparedScene {
         })
     }
 
+    /// The 4-wide tree `method` traverses ([`WideMethod::Bvh4`] or [`WideMethod::Bvh4Naive`]).
+    pub fn wide4(&self, method: WideMethod) -> Result<&WideBvh<4>, Error> {
+        let tree = match method {
+            WideMethod::Bvh4 => &self.wide4,
+            WideMethod::Bvh4Naive => &self.wide4_naive,
+            WideMethod::Bvh8 => return Err(Error::Unsupported { method: method.name(), by: "a 4-wide traversal" }),
+        };
+        tree.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "its 4-wide tree" })
+    }
+
+    /// The 8-wide tree `method` traverses ([`WideMethod::Bvh8`]).
+    pub fn wide8(&self, method: WideMethod) -> Result<&WideBvh<8>, Error> {
+        match method {
+            WideMethod::Bvh8 => {
+                self.wide8.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "its 8-wide tree" })
+            }
+            _ => Err(Error::Unsupported { method: method.name(), by: "an 8-wide traversal" }),
+        }
+    }
+
+    /// Where `method` starts, with the BVH2 methods' scene scale (so its slack is theirs).
+    pub fn wide_root(&self, method: WideMethod) -> Result<WideRoot, Error> {
+        let (root, nodes, leaves) = match method.width() {
+            4 => self.wide4(method).map(|t| (t.root(), t.stats().nodes, t.stats().leaves))?,
+            _ => self.wide8(method).map(|t| (t.root(), t.stats().nodes, t.stats().leaves))?,
+        };
+        let b = self.bvh.nodes()[0].bounds;
+        Ok(WideRoot {
+            root,
+            scene_scale: b.min.abs().max(b.max.abs()).max_element(),
+            max_steps: (nodes + leaves).min(u32::MAX as usize) as u32,
+        })
+    }
+
     /// Checks that the scene holds everything `method` reads, so a backend fails before it
     /// starts (and before it times anything).
     pub fn check_prepared(&self, method: Method) -> Result<(), Error> {
         match method {
             Method::Bvh2(m) => self.memory(m).map(|_| ()),
             Method::Kd(_) => self.kd_memory().map(|_| ()),
+            Method::Wide(m) => self.wide_root(m).map(|_| ()),
         }
     }
 

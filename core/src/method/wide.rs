@@ -1,0 +1,68 @@
+use core::fmt;
+
+/// A traversal method of a wide BVH, collapsed from the canonical BVH2 (Guthe 2014).
+///
+/// Each visits a node's children at once: their boxes are tested together (independent
+/// instruction sequences, the paper's point), closest-hit queries order the hit children by entry
+/// distance with a sorting network, and any-hit queries push them unsorted (Sec. 4.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum WideMethod {
+    /// Four children per node, by Guthe's pull-up (Sec. 4.1).
+    Bvh4,
+    /// Eight children per node, by the same pull-up (the width of Garanzha & Loop's tree).
+    Bvh8,
+    /// Four children per node by removing every second level of the binary tree: the naive
+    /// collapse the pull-up is measured against.
+    Bvh4Naive,
+}
+
+/// How a wide tree is collapsed from the binary one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Collapse {
+    /// Guthe's pull-up: the largest child first, with the paper's rules near the leaves.
+    PullUp,
+    /// Every second level removed.
+    EverySecondLevel,
+}
+
+impl WideMethod {
+    /// Every wide method.
+    pub const ALL: [WideMethod; 3] = [WideMethod::Bvh4, WideMethod::Bvh8, WideMethod::Bvh4Naive];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            WideMethod::Bvh4 => "bvh4",
+            WideMethod::Bvh8 => "bvh8",
+            WideMethod::Bvh4Naive => "bvh4-naive",
+        }
+    }
+
+    /// Children per node.
+    pub fn width(self) -> usize {
+        match self {
+            WideMethod::Bvh4 | WideMethod::Bvh4Naive => 4,
+            WideMethod::Bvh8 => 8,
+        }
+    }
+
+    /// How the method's tree is collapsed.
+    pub fn collapse(self) -> Collapse {
+        match self {
+            WideMethod::Bvh4 | WideMethod::Bvh8 => Collapse::PullUp,
+            WideMethod::Bvh4Naive => Collapse::EverySecondLevel,
+        }
+    }
+
+    /// Per-ray state in bytes for a wide tree of `depth` levels: node address, current entry
+    /// distance, stack pointer, and `width - 1` entries of (node, entry distance) per level.
+    pub fn state_bytes(self, depth: u32) -> usize {
+        4 + 4 + 4 + 8 * (self.width() - 1) * depth as usize
+    }
+}
+
+impl fmt::Display for WideMethod {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}

@@ -1,0 +1,41 @@
+use super::node::WideNode;
+use crate::bvh2::MemRead;
+use crate::geometry::Triangle;
+use glam::Vec3;
+
+/// Every memory read a wide-BVH traversal makes goes through this trait (see
+/// [`BvhMemory`](crate::bvh2::BvhMemory) for why).
+pub trait WideMemory<const W: usize> {
+    /// Node `index`.
+    fn wide_node(&self, index: u32) -> MemRead<'_, WideNode<W>>;
+    /// The primitive id of the triangle at position `pos`.
+    fn prim(&self, pos: u32) -> u32;
+    /// The vertices of the triangle at position `pos`.
+    fn wide_triangle(&self, pos: u32) -> MemRead<'_, [Vec3; 3]>;
+}
+
+/// A wide tree in plain slices: the CPU backend's memory.
+#[derive(Clone, Copy, Debug)]
+pub struct WideSliceMemory<'a, const W: usize> {
+    /// Nodes.
+    pub nodes: &'a [WideNode<W>],
+    /// Triangles in leaf order.
+    pub triangles: &'a [Triangle],
+    /// Primitive id per triangle position.
+    pub prims: &'a [u32],
+}
+
+impl<const W: usize> WideMemory<W> for WideSliceMemory<'_, W> {
+    #[inline(always)]
+    fn wide_node(&self, index: u32) -> MemRead<'_, WideNode<W>> {
+        MemRead::InPlace(&self.nodes[index as usize])
+    }
+    #[inline(always)]
+    fn prim(&self, pos: u32) -> u32 {
+        self.prims[pos as usize]
+    }
+    #[inline(always)]
+    fn wide_triangle(&self, pos: u32) -> MemRead<'_, [Vec3; 3]> {
+        MemRead::InPlace(&self.triangles[pos as usize].v)
+    }
+}

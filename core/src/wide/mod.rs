@@ -1,0 +1,23 @@
+//! Wide BVHs collapsed from the canonical binary tree, and their traversal (Guthe 2014).
+//!
+//! - [`WideNode`]: `W` child boxes as a structure of arrays, child references and leaf ranges,
+//!   `Pod`, one byte layout for the CPU and the WGSL kernels;
+//! - [`WideBvh`]: the collapse (Guthe's pull-up, or every second level removed), keeping every
+//!   binary leaf whole (needs `alloc`);
+//! - [`ChildKernel`]: testing and ordering a node's children, by the plain [`ReferenceKernel`] or
+//!   the [`FastKernel`] (SIMD box tests, the sorting network of [`network`]) that must equal it;
+//! - [`traverse`]: the state machine.
+
+mod kernel;
+mod memory;
+pub mod network;
+mod node;
+pub mod traverse;
+#[cfg(feature = "alloc")]
+mod tree;
+
+pub use kernel::{sort_keys, ChildHits, ChildKernel, FastKernel, ReferenceKernel};
+pub use memory::{WideMemory, WideSliceMemory};
+pub use node::{WideChild, WideNode, EMPTY_CHILD};
+#[cfg(feature = "alloc")]
+pub use tree::{WideBvh, WideStats};

@@ -1,0 +1,214 @@
+//! The wide-BVH traversal (Guthe 2014): a stack of (child, entry distance), all children of a node
+//! tested at once, hit children nearest first for closest-hit queries and unsorted for any-hit
+//! queries (Sec. 4.2: all hit children but one are pushed, none sorted).
+
+use super::kernel::ChildKernel;
+use super::memory::WideMemory;
+use super::node::WideChild;
+use crate::intersect::{NoPair, RayContext, TriangleTest};
+use crate::method::Query;
+use crate::observe::{Backtrack, Observer};
+use crate::traverse::{begin, QueryState, Step};
+use crate::{Hit, Ray};
+
+/// Stack entries: enough for `W - 1` postponed children on each of 63 levels, `W` up to 8.
+pub const WIDE_STACK: usize = 448;
+
+/// The context of a wide traversal: the slab constants alone are its box constants.
+pub type WideRayContext<T> = RayContext<T, NoPair>;
+
+/// Where a wide traversal starts, with the scene constants every ray needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WideRoot {
+    /// The root: node 0, or a leaf for a one-leaf tree.
+    pub root: WideChild,
+    /// The largest coordinate magnitude in the scene (as for the BVH2 methods, so the slack is
+    /// theirs).
+    pub scene_scale: f32,
+    /// Steps after which traversal stops (never binds on an intact tree).
+    pub max_steps: u32,
+}
+
+/// One ray's traversal state: the child being visited, and the postponed children with the entry
+/// distances they were found at.
+#[derive(Clone, Debug)]
+pub struct WideState<const W: usize> {
+    current: Option<WideChild>,
+    len: usize,
+    stack: [(WideChild, f32); WIDE_STACK],
+}
+
+impl<const W: usize> WideState<W> {
+    /// Starts at `root`.
+    pub fn new(root: WideChild) -> Self {
+        Self { current: Some(root), len: 0, stack: [(root, 0.0); WIDE_STACK] }
+    }
+
+    /// Starts over at `root` for another ray, keeping the stack's storage.
+    #[inline(always)]
+    pub fn restart(&mut self, root: WideChild) {
+        self.current = Some(root);
+        self.len = 0;
+    }
+
+    /// Processes one node or leaf; see [`Step`].
+    #[inline(always)]
+    pub fn step<M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
+        &mut self,
+        mem: &M,
+        ctx: &WideRayContext<T>,
+        q: &mut QueryState,
+        obs: &mut O,
+    ) -> Step {
+        let Some(current) = self.current else { return Step::Done };
+        obs.node(current.node_ref());
+        match current {
+            WideChild::Node(index) => {
+                let node = mem.wide_node(index);
+                let (lo, hi) = ctx.box_interval(q.limit());
+                let hits = K::test::<W>(&node, &ctx.slab, lo, hi);
+                if hits.mask == 0 {
+                    return self.pop(ctx, q, obs, false);
+                }
+                let mut order = [0u32; W];
+                let n = if q.any {
+                    // Unsorted: slot order.
+                    let mut m = hits.mask;
+                    let mut n = 0;
+                    while m != 0 {
+                        order[n] = m.trailing_zeros();
+                        m &= m - 1;
+                        n += 1;
+                    }
+                    n
+                } else {
+                    K::order::<W>(&hits, &mut order)
+                };
+                // Push all but the first, farthest first, so the next nearest is popped next.
+                for k in (1..n).rev() {
+                    let slot = order[k] as usize;
+                    if self.len < WIDE_STACK {
+                        if let Some(c) = node.child_ref(slot) {
+                            self.stack[self.len] = (c, hits.t_enter[slot % W]);
+                            self.len += 1;
+                        }
+                    }
+                }
+                self.current = node.child_ref(order[0] as usize);
+                Step::Continue
+            }
+            WideChild::Leaf { first, count } => {
+                let hit = leaf(mem, first, count, ctx, q, obs);
+                if q.is_answered() {
+                    return Step::Done;
+                }
+                self.pop(ctx, q, obs, hit)
+            }
+        }
+    }
+
+    /// Goes on with the nearest postponed child that may still hold a closer hit: one entered
+    /// beyond the closest hit by more than the ray's slack cannot (a triangle's computed `t`
+    /// strays from its box's interval by less), so it is dropped unvisited.
+    #[inline(always)]
+    fn pop<O: Observer>(
+        &mut self,
+        ctx: &WideRayContext<impl TriangleTest>,
+        q: &QueryState,
+        obs: &mut O,
+        after_hit: bool,
+    ) -> Step {
+        while self.len > 0 {
+            self.len -= 1;
+            let (child, t_enter) = self.stack[self.len];
+            obs.backtrack(0, Backtrack::StackPop);
+            if t_enter > q.limit() + ctx.t_slack {
+                continue;
+            }
+            self.current = Some(child);
+            return if after_hit { Step::AfterHit } else { Step::Continue };
+        }
+        self.current = None;
+        Step::Done
+    }
+}
+
+/// Tests the ray against the `count` triangles from position `first`; returns whether a hit was
+/// taken. An any-hit query stops at its first hit.
+#[inline(always)]
+fn leaf<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
+    mem: &M,
+    first: u32,
+    count: u32,
+    ctx: &WideRayContext<T>,
+    q: &mut QueryState,
+    obs: &mut O,
+) -> bool {
+    let per_ray = ctx.tri();
+    let mut taken = false;
+    for pos in first..first + count {
+        let prim = mem.prim(pos);
+        obs.primitive(prim);
+        let tri = mem.wide_triangle(pos);
+        let [a, b, c] = &*tri;
+        if let Some(h) = T::intersect_in_place(&per_ray, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit())
+        {
+            if q.offer(h, prim) {
+                obs.hit(prim, h.t);
+                taken = true;
+                if q.any {
+                    return true;
+                }
+            }
+        }
+    }
+    taken
+}
+
+/// Traces `rays` into `hits` (pairs up to the shorter of the two) over a `W`-wide tree, the
+/// children tested and ordered by `K`, with the stack set up once per batch.
+#[inline]
+pub fn trace_wide_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    obs: &mut O,
+) {
+    let mut state = WideState::<W>::new(root.root);
+    for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+        *hit = match begin::<T, NoPair>(ray, root.scene_scale, query) {
+            Some((ctx, mut q)) => {
+                state.restart(root.root);
+                let mut budget = root.max_steps;
+                while state.step::<M, T, K, O>(mem, &ctx, &mut q, obs) != Step::Done && budget > 0 {
+                    budget -= 1;
+                }
+                q.hit
+            }
+            None => Hit::MISS,
+        };
+    }
+}
+
+/// Traces one ray over a `W`-wide tree; see [`trace_wide_batch`].
+#[inline]
+pub fn trace_wide_ray<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
+    mem: &M,
+    root: WideRoot,
+    ray: &Ray,
+    query: Query,
+    obs: &mut O,
+) -> Hit {
+    let mut hit = Hit::MISS;
+    trace_wide_batch::<W, M, T, K, O>(
+        mem,
+        root,
+        core::slice::from_ref(ray),
+        core::slice::from_mut(&mut hit),
+        query,
+        obs,
+    );
+    hit
+}

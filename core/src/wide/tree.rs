@@ -1,0 +1,225 @@
+use super::node::{WideChild, WideNode};
+use crate::bvh2::{Bvh2, NodeKind, NodeRef};
+use crate::geometry::Triangle;
+use crate::method::Collapse;
+use crate::Error;
+use alloc::vec::Vec;
+
+/// Shape figures of a wide tree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WideStats {
+    /// Internal nodes.
+    pub nodes: usize,
+    /// Leaves (the binary tree's leaves, each kept whole).
+    pub leaves: usize,
+    /// Depth of the deepest leaf (a leaf child of the root: 1).
+    pub depth: u32,
+    /// Child slots left empty, over all nodes.
+    pub empty_slots: usize,
+    /// Bytes of the nodes.
+    pub node_bytes: usize,
+}
+
+/// A `W`-wide BVH collapsed from a canonical BVH2 (Guthe 2014, Sec. 4.1), with its triangles in
+/// leaf order. Every wide node stands for the binary node it was collapsed from, and every leaf is
+/// a binary leaf with the same triangles, so enumerations name canonical BVH2 nodes.
+#[derive(Clone, Debug)]
+pub struct WideBvh<const W: usize> {
+    nodes: Vec<WideNode<W>>,
+    root: WideChild,
+    triangles: Vec<Triangle>,
+    prims: Vec<u32>,
+    node_ids: Vec<u32>,
+    leaf_ids: Vec<u32>,
+    stats: WideStats,
+}
+
+impl<const W: usize> WideBvh<W> {
+    /// Collapses `bvh` (over `triangles`, by primitive id) into a `W`-wide tree, `W` between 2
+    /// and 32.
+    pub fn build(bvh: &Bvh2, triangles: &[Triangle], collapse: Collapse) -> Result<WideBvh<W>, Error> {
+        if !(2..=32).contains(&W) {
+            return Err(Error::MalformedTree("a wide BVH has 2 to 32 children per node"));
+        }
+        let order = bvh.prim_order();
+        let tris = order
+            .iter()
+            .map(|&p| triangles.get(p as usize).copied().ok_or(Error::MalformedTree("primitive id out of range")))
+            .collect::<Result<Vec<Triangle>, Error>>()?;
+        let leaves_below = leaves_below(bvh);
+        let mut b = Builder {
+            bvh,
+            collapse,
+            leaves_below,
+            out: WideBvh {
+                nodes: Vec::new(),
+                root: WideChild::Node(0),
+                triangles: tris,
+                prims: order.to_vec(),
+                node_ids: Vec::new(),
+                leaf_ids: alloc::vec![u32::MAX; order.len()],
+                stats: WideStats { nodes: 0, leaves: 0, depth: 0, empty_slots: 0, node_bytes: 0 },
+            },
+        };
+        let root = b.child(0, 0)?;
+        let mut out = b.out;
+        out.root = root;
+        out.stats.nodes = out.nodes.len();
+        out.stats.node_bytes = out.nodes.len() * core::mem::size_of::<WideNode<W>>();
+        Ok(out)
+    }
+
+    /// The nodes, root first, in depth-first order.
+    pub fn nodes(&self) -> &[WideNode<W>] {
+        &self.nodes
+    }
+
+    /// Where traversal starts: node 0, or a leaf when the binary tree is a single leaf.
+    pub fn root(&self) -> WideChild {
+        self.root
+    }
+
+    /// The triangles in leaf order (a leaf's `first` indexes here).
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// The primitive id of each triangle position.
+    pub fn prims(&self) -> &[u32] {
+        &self.prims
+    }
+
+    /// Shape figures.
+    pub fn stats(&self) -> WideStats {
+        self.stats
+    }
+
+    /// The canonical BVH2 id of a recorded reference ([`WideChild::node_ref`]), if it names a node
+    /// or leaf of this tree.
+    pub fn canonical_id(&self, r: NodeRef) -> Option<u32> {
+        let id = if r.is_leaf() {
+            *self.leaf_ids.get(r.offset() as usize)?
+        } else {
+            *self.node_ids.get(r.index() as usize)?
+        };
+        (id != u32::MAX).then_some(id)
+    }
+}
+
+/// Leaves below each canonical node.
+fn leaves_below(bvh: &Bvh2) -> Vec<u32> {
+    let nodes = bvh.nodes();
+    let mut below = alloc::vec![0u32; nodes.len()];
+    // Pre-order: children follow their parent, so a reverse sweep sees children first.
+    for i in (0..nodes.len()).rev() {
+        below[i] = match nodes[i].kind {
+            NodeKind::Leaf { .. } => 1,
+            NodeKind::Internal { left, right } => below[left as usize] + below[right as usize],
+        };
+    }
+    below
+}
+
+struct Builder<'a, const W: usize> {
+    bvh: &'a Bvh2,
+    collapse: Collapse,
+    leaves_below: Vec<u32>,
+    out: WideBvh<W>,
+}
+
+impl<const W: usize> Builder<'_, W> {
+    /// The wide child standing for canonical node `n` at wide depth `depth`, building its subtree.
+    fn child(&mut self, n: u32, depth: u32) -> Result<WideChild, Error> {
+        let node = self.bvh.nodes()[n as usize];
+        match node.kind {
+            NodeKind::Leaf { first, count } => {
+                self.out.leaf_ids[first as usize] = n;
+                self.out.stats.leaves += 1;
+                self.out.stats.depth = self.out.stats.depth.max(depth);
+                Ok(WideChild::Leaf { first, count })
+            }
+            NodeKind::Internal { .. } => {
+                let index = u32::try_from(self.out.nodes.len())
+                    .ok()
+                    .filter(|&i| i < NodeRef::LIMIT)
+                    .ok_or(Error::TreeTooLarge { what: "wide nodes", size: self.out.nodes.len() })?;
+                self.out.nodes.push(WideNode::EMPTY);
+                self.out.node_ids.push(n);
+                let slots = self.slots(n);
+                self.out.stats.empty_slots += W - slots.len();
+                for (i, &c) in slots.iter().enumerate() {
+                    let b = self.bvh.nodes()[c as usize].bounds;
+                    let child = self.child(c, depth + 1)?;
+                    self.out.nodes[index as usize].set_child(i, b.min, b.max, child);
+                }
+                Ok(WideChild::Node(index))
+            }
+        }
+    }
+
+    /// The canonical nodes that become the children of internal node `n`, in slot order (the
+    /// binary tree's left-to-right order).
+    fn slots(&self, n: u32) -> Vec<u32> {
+        let mut c = self.children(n).map_or_else(Vec::new, |(l, r)| alloc::vec![l, r]);
+        match self.collapse {
+            Collapse::EverySecondLevel => loop {
+                let next: Vec<u32> = c
+                    .iter()
+                    .flat_map(|&x| self.children(x).map_or([x, u32::MAX], |(l, r)| [l, r]))
+                    .filter(|&x| x != u32::MAX)
+                    .collect();
+                if next.len() > W || next.len() == c.len() {
+                    return c;
+                }
+                c = next;
+            },
+            Collapse::PullUp => {
+                let mut pulled = 0;
+                while c.len() < W {
+                    let Some(at) = self.pick(&c, pulled) else { break };
+                    // `pick` only returns internal children.
+                    let Some((l, r)) = self.children(c[at]) else { break };
+                    c.splice(at..=at, [l, r]);
+                    pulled += 1;
+                }
+                c
+            }
+        }
+    }
+
+    /// Which of the current children to pull up next (Guthe 2014, Sec. 4.1): a child with two
+    /// leaves first (pulling it up removes a node), the largest box among them; else a child with
+    /// three leaves if nothing was pulled up yet, or if it is the only internal child; else the
+    /// internal child with the largest box. Ties go to the leftmost.
+    fn pick(&self, c: &[u32], pulled: usize) -> Option<usize> {
+        let internal: Vec<usize> = (0..c.len()).filter(|&i| self.children(c[i]).is_some()).collect();
+        let largest = |among: &mut dyn Iterator<Item = usize>| -> Option<usize> {
+            among.fold(None, |best: Option<usize>, i| match best {
+                Some(b) if self.area(c[b]) >= self.area(c[i]) => Some(b),
+                _ => Some(i),
+            })
+        };
+        let below = |i: usize| self.leaves_below[c[i] as usize];
+        if let Some(i) = largest(&mut internal.iter().copied().filter(|&i| below(i) == 2)) {
+            return Some(i);
+        }
+        let three_ok = pulled == 0 || internal.len() == 1;
+        if three_ok {
+            if let Some(i) = largest(&mut internal.iter().copied().filter(|&i| below(i) == 3)) {
+                return Some(i);
+            }
+        }
+        largest(&mut internal.iter().copied().filter(|&i| below(i) != 3))
+    }
+
+    fn children(&self, n: u32) -> Option<(u32, u32)> {
+        match self.bvh.nodes()[n as usize].kind {
+            NodeKind::Internal { left, right } => Some((left, right)),
+            NodeKind::Leaf { .. } => None,
+        }
+    }
+
+    fn area(&self, n: u32) -> f32 {
+        self.bvh.nodes()[n as usize].bounds.half_area()
+    }
+}
