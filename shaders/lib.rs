@@ -89,6 +89,8 @@ pub const TRIANGLE_MOLLER_TRUMBORE: Source =
 /// `triangle_watertight.wgsl`.
 pub const TRIANGLE_WATERTIGHT: Source =
     Source { name: "triangle_watertight.wgsl", text: include_str!("triangle_watertight.wgsl") };
+/// `wide.wgsl`.
+pub const WIDE: Source = Source { name: "wide.wgsl", text: include_str!("wide.wgsl") };
 
 /// Every file, in name order.
 pub const ALL: &[Source] = &[

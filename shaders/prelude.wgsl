@@ -48,7 +48,8 @@ struct Params {
     short_stack: u32,
     kd_prims: u32,
     kd_tris: u32,
-    _pad0: u32,
+    // Wide BVH: the root leaf's triangle count (0: the root is node `root`).
+    wide_root_count: u32,
     _pad1: u32,
     // kd: scene box.
     kd_lo: vec4<f32>,
@@ -62,7 +63,8 @@ struct Params {
 @group(0) @binding(3) var<storage, read> bvh: array<vec4<u32>>;
 // Perfect hash: the displacement table, then the cells from `P.d_mask + 1`.
 @group(0) @binding(4) var<storage, read> hash_tables: array<u32>;
-// kd-tree: nodes (two words each), references from `P.kd_prims`, triangles from `P.kd_tris`.
+// kd-tree: nodes (two words each), references from `P.kd_prims`, triangles from `P.kd_tris`;
+// or a wide BVH, laid out as wide.wgsl says.
 @group(0) @binding(5) var<storage, read> kd: array<u32>;
 // Per ray: event count, counters, then node events (see record.wgsl).
 @group(0) @binding(6) var<storage, read_write> records: array<u32>;

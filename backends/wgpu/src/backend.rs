@@ -14,6 +14,7 @@ use raytrail_core::method::{KdMethod, Method};
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
+use raytrail_core::wide::WideChild;
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 use std::time::Instant;
@@ -136,6 +137,20 @@ impl WgpuBackend {
                 params.kd_hi = [root.hi.x, root.hi.y, root.hi.z, 0.0];
                 SceneBindings { bvh: &scene.empty, hash: &scene.empty, kd: &kd.buffer }
             }
+            Method::Wide(m) => {
+                let root = p.wide_root(m)?;
+                let tree =
+                    scene.wide_for(m).ok_or(Error::NotPrepared { method: m.name(), missing: "its wide tree" })?;
+                params.max_steps = root.max_steps;
+                params.scene_scale = root.scene_scale;
+                params.kd_prims = tree.prims;
+                params.kd_tris = tree.tris;
+                (params.root, params.wide_root_count) = match root.root {
+                    WideChild::Node(n) => (n, 0),
+                    WideChild::Leaf { first, count } => (NodeRef::leaf(first).0, count),
+                };
+                SceneBindings { bvh: &scene.empty, hash: &scene.empty, kd: &tree.buffer }
+            }
             other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
         };
         // Packets are grouped as the core says (every backend alike): the batch is rearranged into
@@ -212,9 +227,9 @@ impl Trace for WgpuBackend {
         "wgpu"
     }
 
-    /// Every BVH2 and kd method.
+    /// Every BVH2, kd and wide-BVH method.
     fn supports(&self, method: Method) -> bool {
-        matches!(method, Method::Bvh2(_) | Method::Kd(_))
+        matches!(method, Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_))
     }
 
     fn prepare(&self, scene: Arc<PreparedScene>) -> Result<WgpuScene, Error> {

@@ -45,6 +45,7 @@ const KD_STACK: Part = part!(KD_STACK);
 const KD_RESTART: Part = part!(KD_RESTART);
 const KD_PACKET: Part = part!(KD_PACKET);
 const ENTRY: Part = part!(ENTRY);
+const WIDE: Part = part!(WIDE);
 
 /// Everything that selects a kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -98,6 +99,7 @@ impl Variant {
                 &[KD_COMMON, KD_RESTART]
             }
             Method::Kd(KdMethod::Packet) => &[KD_COMMON, KD_PACKET],
+            Method::Wide(_) => &[WIDE],
             other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
         };
         parts.extend_from_slice(method);
@@ -138,6 +140,7 @@ impl Variant {
 /// Constants the shaders must share with the core bit for bit, written from the core's own
 /// values rather than retyped as WGSL literals (which a compiler would round its own way).
 fn constants_header(method: Method) -> String {
+    let wide_width = method.wide().map_or(4, |m| m.width());
     let kd_mode = match method {
         Method::Kd(KdMethod::Restart) => 0,
         Method::Kd(KdMethod::PushDown) => 1,
@@ -151,7 +154,9 @@ fn constants_header(method: Method) -> String {
          // kd restart family: 0 restart, 1 push-down, 2 short stack.\n\
          const KD_MODE: u32 = {kd_mode}u;\n\
          const SHORT_STACK_MAX: u32 = {SHORT_STACK_MAX}u;\n\
-         const PACKET_WIDTH: u32 = {PACKET_WIDTH}u;\n",
+         const PACKET_WIDTH: u32 = {PACKET_WIDTH}u;\n\
+         // Children per wide node.\n\
+         const WIDE_W: u32 = {wide_width}u;\n",
         FAR_PAD.to_bits(),
         SLACK_SCALE.to_bits(),
         RELIABLE_LIMIT.to_bits(),
@@ -208,7 +213,7 @@ mod tests {
             failures.len(),
             failures.join("\n")
         );
-        assert_eq!(n, 2 * 12 * 2 * 2 * 3);
+        assert_eq!(n, 2 * Method::ALL.len() * 2 * 2 * 3);
     }
 
     #[test]

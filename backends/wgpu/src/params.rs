@@ -21,7 +21,8 @@ pub(crate) struct Params {
     pub short_stack: u32,
     pub kd_prims: u32,
     pub kd_tris: u32,
-    pub pad: [u32; 2],
+    pub wide_root_count: u32,
+    pub pad: u32,
     pub kd_lo: [f32; 4],
     pub kd_hi: [f32; 4],
 }

@@ -3,8 +3,9 @@
 
 use crate::device::{device_error, Gpu};
 use raytrail_core::bvh2::BinaryLayout;
-use raytrail_core::method::Bvh2Method;
+use raytrail_core::method::{Bvh2Method, WideMethod};
 use raytrail_core::prepared::{BuiltHash, PreparedScene};
+use raytrail_core::wide::WideBvh;
 use raytrail_core::Error;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -39,6 +40,10 @@ pub struct WgpuScene {
     pub(crate) hash: Option<HashBuffer>,
     pub(crate) full_hash: Option<HashBuffer>,
     pub(crate) kd: Option<KdBuffer>,
+    /// The wide trees, laid out as the kd-tree is: nodes, primitive ids, triangles.
+    pub(crate) wide4: Option<KdBuffer>,
+    pub(crate) wide8: Option<KdBuffer>,
+    pub(crate) wide4_naive: Option<KdBuffer>,
     /// A small buffer bound where a kernel's unused bindings would be.
     pub(crate) empty: wgpu::Buffer,
 }
@@ -77,6 +82,31 @@ fn layout(gpu: &Gpu, label: &str, l: &BinaryLayout) -> Result<LayoutBuffer, Erro
     Ok(LayoutBuffer { buffer: storage(gpu, label, &words)?, leaf_base })
 }
 
+/// Nodes, then primitive references, then triangles (nine words each), with the offsets of the
+/// last two: the kd-tree's layout, which the wide trees share.
+fn nodes_prims_triangles(
+    gpu: &Gpu,
+    label: &str,
+    nodes: &[u32],
+    prims: &[u32],
+    triangles: &[raytrail_core::geometry::Triangle],
+) -> Result<KdBuffer, Error> {
+    let mut words = Vec::with_capacity(nodes.len() + prims.len() + triangles.len() * 9);
+    words.extend_from_slice(nodes);
+    words.extend_from_slice(prims);
+    words.extend(triangles.iter().flat_map(|t| t.v).flat_map(|v| v.to_array()).map(f32::to_bits));
+    let too_big = |_| device_error(format!("{label} exceeds 32-bit word offsets"));
+    Ok(KdBuffer {
+        buffer: storage(gpu, label, &words)?,
+        prims: u32::try_from(nodes.len()).map_err(too_big)?,
+        tris: u32::try_from(nodes.len() + prims.len()).map_err(too_big)?,
+    })
+}
+
+fn wide<const W: usize>(gpu: &Gpu, label: &str, t: &WideBvh<W>) -> Result<KdBuffer, Error> {
+    nodes_prims_triangles(gpu, label, bytemuck::cast_slice(t.nodes()), t.prims(), t.triangles())
+}
+
 fn hash(gpu: &Gpu, label: &str, h: &BuiltHash) -> Result<HashBuffer, Error> {
     let t = &h.tables;
     let mut words: Vec<u32> = Vec::with_capacity(t.displacement.len() + t.cells.len());
@@ -93,25 +123,23 @@ impl WgpuScene {
         let parents = p.parents.as_ref().map(|l| layout(gpu, "parent/sibling layout", l)).transpose()?;
         let hash_tables = p.hash.as_ref().map(|h| hash(gpu, "hash tables", h)).transpose()?;
         let full_hash = p.full_hash.as_ref().map(|h| hash(gpu, "full hash tables", h)).transpose()?;
-        let kd = match &p.kd {
-            None => None,
-            Some(kd) => {
-                let nodes: &[u32] = bytemuck::cast_slice(kd.tree.nodes());
-                let prims = kd.tree.prims();
-                let mut words = Vec::with_capacity(nodes.len() + prims.len() + kd.triangles.len() * 9);
-                words.extend_from_slice(nodes);
-                words.extend_from_slice(prims);
-                words.extend(kd.triangles.iter().flat_map(|t| t.v).flat_map(|v| v.to_array()).map(f32::to_bits));
-                let too_big = |_| device_error("the kd-tree exceeds 32-bit word offsets");
-                Some(KdBuffer {
-                    buffer: storage(gpu, "kd-tree", &words)?,
-                    prims: u32::try_from(nodes.len()).map_err(too_big)?,
-                    tris: u32::try_from(nodes.len() + prims.len()).map_err(too_big)?,
+        let kd =
+            p.kd.as_ref()
+                .map(|kd| {
+                    nodes_prims_triangles(
+                        gpu,
+                        "kd-tree",
+                        bytemuck::cast_slice(kd.tree.nodes()),
+                        kd.tree.prims(),
+                        &kd.triangles,
+                    )
                 })
-            }
-        };
+                .transpose()?;
+        let wide4 = p.wide4.as_ref().map(|t| wide(gpu, "4-wide BVH", t)).transpose()?;
+        let wide8 = p.wide8.as_ref().map(|t| wide(gpu, "8-wide BVH", t)).transpose()?;
+        let wide4_naive = p.wide4_naive.as_ref().map(|t| wide(gpu, "naive 4-wide BVH", t)).transpose()?;
         let empty = storage(gpu, "empty", &[])?;
-        Ok(WgpuScene { prepared, uncles, parents, hash: hash_tables, full_hash, kd, empty })
+        Ok(WgpuScene { prepared, uncles, parents, hash: hash_tables, full_hash, kd, wide4, wide8, wide4_naive, empty })
     }
 
     /// The layout buffer `method` reads.
@@ -134,14 +162,27 @@ impl WgpuScene {
         }
     }
 
+    /// The wide tree buffer `method` reads.
+    pub(crate) fn wide_for(&self, method: WideMethod) -> Option<&KdBuffer> {
+        match method {
+            WideMethod::Bvh4 => self.wide4.as_ref(),
+            WideMethod::Bvh8 => self.wide8.as_ref(),
+            WideMethod::Bvh4Naive => self.wide4_naive.as_ref(),
+        }
+    }
+
     /// Bytes on the device.
     pub fn device_bytes(&self) -> u64 {
         let l = |b: &Option<LayoutBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
         let h = |b: &Option<HashBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
+        let k = |b: &Option<KdBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
         l(&self.uncles)
             + l(&self.parents)
             + h(&self.hash)
             + h(&self.full_hash)
-            + self.kd.as_ref().map_or(0, |k| k.buffer.size())
+            + k(&self.kd)
+            + k(&self.wide4)
+            + k(&self.wide8)
+            + k(&self.wide4_naive)
     }
 }
