@@ -1,0 +1,84 @@
+//! The wide trees collapsed from the binary one: every binary leaf kept whole and reached once,
+//! child boxes the binary nodes' own, the width respected, and the pull-up's shape against the
+//! naive collapse (Guthe 2014, Sec. 4.1).
+
+use raytrail_core::bvh2::{Bvh2, NodeKind, SahBuilder, SahConfig};
+use raytrail_core::method::Collapse;
+use raytrail_core::wide::{WideBvh, WideChild};
+
+mod common;
+use common::soup;
+
+/// Walks the wide tree and checks it against the binary one; returns the binary leaves reached.
+fn check<const W: usize>(bvh: &Bvh2, wide: &WideBvh<W>) -> Vec<u32> {
+    let mut leaves = Vec::new();
+    let mut todo = vec![wide.root()];
+    while let Some(c) = todo.pop() {
+        match c {
+            WideChild::Leaf { first, count } => {
+                let id = wide.canonical_id(c.node_ref()).expect("a leaf names a binary leaf");
+                assert_eq!(bvh.nodes()[id as usize].kind, NodeKind::Leaf { first, count }, "leaf {id} kept whole");
+                leaves.push(id);
+            }
+            WideChild::Node(n) => {
+                let node = &wide.nodes()[n as usize];
+                let mut filled = 0;
+                for i in 0..W {
+                    let Some(child) = node.child_ref(i) else { continue };
+                    filled += 1;
+                    let id = wide.canonical_id(child.node_ref()).expect("a child names a binary node");
+                    let b = bvh.nodes()[id as usize].bounds;
+                    assert_eq!(node.child_box(i), (b.min, b.max), "child {i} of node {n} has its binary node's box");
+                    todo.push(child);
+                }
+                assert!(filled >= 2, "node {n} has {filled} children");
+            }
+        }
+    }
+    leaves.sort_unstable();
+    leaves
+}
+
+fn binary_leaves(bvh: &Bvh2) -> Vec<u32> {
+    (0..bvh.len() as u32).filter(|&i| matches!(bvh.nodes()[i as usize].kind, NodeKind::Leaf { .. })).collect()
+}
+
+#[test]
+fn every_binary_leaf_is_reached_once_with_its_box_and_triangles() {
+    for (seed, leaf) in [(1, 1), (2, 4), (3, 8)] {
+        let tris = soup(3000, seed, 2.0);
+        let bvh = SahBuilder::new(SahConfig { max_leaf_size: leaf, ..SahConfig::default() }).build(&tris).unwrap();
+        let expected = binary_leaves(&bvh);
+        for collapse in [Collapse::PullUp, Collapse::EverySecondLevel] {
+            let w4 = WideBvh::<4>::build(&bvh, &tris, collapse).unwrap();
+            assert_eq!(check(&bvh, &w4), expected, "4-wide {collapse:?}");
+            let w8 = WideBvh::<8>::build(&bvh, &tris, collapse).unwrap();
+            assert_eq!(check(&bvh, &w8), expected, "8-wide {collapse:?}");
+            assert_eq!(w4.stats().leaves, expected.len());
+        }
+    }
+}
+
+#[test]
+fn the_pull_up_fills_nodes_better_than_removing_every_second_level() {
+    let tris = soup(20_000, 7, 2.0);
+    let bvh = SahBuilder::default().build(&tris).unwrap();
+    let internal = bvh.len() - binary_leaves(&bvh).len();
+    let pull = WideBvh::<4>::build(&bvh, &tris, Collapse::PullUp).unwrap().stats();
+    let naive = WideBvh::<4>::build(&bvh, &tris, Collapse::EverySecondLevel).unwrap().stats();
+    let eight = WideBvh::<8>::build(&bvh, &tris, Collapse::PullUp).unwrap().stats();
+    // Each pull-up removes one binary node: a 4-wide node stands for up to three.
+    assert!(pull.nodes * 3 >= internal && pull.nodes < internal, "{pull:?} from {internal} binary nodes");
+    assert!(pull.nodes <= naive.nodes, "pull-up {pull:?}, naive {naive:?}");
+    assert!(pull.empty_slots <= naive.empty_slots, "pull-up {pull:?}, naive {naive:?}");
+    assert!(eight.nodes < pull.nodes && eight.depth <= pull.depth, "8-wide {eight:?}, 4-wide {pull:?}");
+}
+
+#[test]
+fn a_single_leaf_tree_is_a_leaf_root() {
+    let tris = soup(1, 3, 1.0);
+    let bvh = SahBuilder::default().build(&tris).unwrap();
+    let w = WideBvh::<4>::build(&bvh, &tris, Collapse::PullUp).unwrap();
+    assert_eq!(w.root(), WideChild::Leaf { first: 0, count: 1 });
+    assert!(w.nodes().is_empty());
+}
