@@ -10,6 +10,7 @@ use raytrail::core::method::{Bvh2Method, KdMethod, Method, Query};
 use raytrail::core::observe::Counters;
 use raytrail::core::prepared::{BuiltHash, PreparedScene};
 use raytrail::core::trace::{Record, Trace, TraceOptions};
+use raytrail::core::wide::WideStats;
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::{load_scene, Builder, BUILTIN_SCENE};
@@ -70,8 +71,6 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     }
     let gpu = gpu.ok();
     let sets = ray_sets(&backend, &cpu, scene, width, height)?;
-    let depth = prepared.bvh.stats().depth;
-    let key_bytes = prepared.key_width().bytes();
     let mut failures: Vec<Mismatch> = Vec::new();
     let gpu_steps = if gpu.is_some() { sets.len() * (Method::ALL.len() + 1) } else { 0 };
     let mut progress = Progress::new("tracing", sets.len() * Method::ALL.len() * (passes + 1) + sets.len() + gpu_steps);
@@ -118,7 +117,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     }
     progress.finish();
     for t in &tables {
-        print_table(t, depth, key_bytes);
+        print_table(t, &prepared);
     }
     let per_set: Vec<(&str, Vec<Row>)> = tables.iter().map(|t| (t.set.name, t.rows.clone())).collect();
     print_backtracking(&per_set);
@@ -198,6 +197,22 @@ fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedScene) {
     };
     describe("hash tables (backtracking targets)", &p.hash, p.timings.hash);
     describe("hash tables (every node, for resuming)", &p.full_hash, p.timings.full_hash);
+    let binary_node_bytes = s.internal_nodes * core::mem::size_of::<raytrail::core::bvh2::BinaryNode>();
+    let wide = |label: &str, st: Option<WideStats>| {
+        if let Some(w) = st {
+            println!(
+                "  {label}: {} nodes ({:.0}% of the binary tree's), {} empty slots, depth {}, {:.2} MB of nodes ({:+.0}% against the binary nodes' {:.2} MB)",
+                w.nodes, 100.0 * w.nodes as f64 / s.internal_nodes.max(1) as f64, w.empty_slots, w.depth,
+                mb(w.node_bytes), 100.0 * (w.node_bytes as f64 / binary_node_bytes.max(1) as f64 - 1.0), mb(binary_node_bytes)
+            );
+        }
+    };
+    wide("4-wide BVH (pull-up)", p.wide4.as_ref().map(|t| t.stats()));
+    wide("8-wide BVH (pull-up)", p.wide8.as_ref().map(|t| t.stats()));
+    wide("4-wide BVH (every second level)", p.wide4_naive.as_ref().map(|t| t.stats()));
+    if p.wide4.is_some() || p.wide8.is_some() || p.wide4_naive.is_some() {
+        println!("  wide trees collapsed in {:.1} ms", 1e3 * p.timings.wide);
+    }
     if let Some(kd) = &p.kd {
         let k = kd.tree.stats();
         println!(
@@ -212,7 +227,7 @@ fn per_ray(x: u64, c: &Counters) -> f64 {
     x as f64 / c.rays.max(1) as f64
 }
 
-fn print_table(t: &SetResult<'_>, depth: u32, key_bytes: usize) {
+fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
     let set = t.set;
     println!(
         "\n{} rays: {} ({} hit), median of timed passes; conformance on {} rays",
@@ -245,7 +260,7 @@ fn print_table(t: &SetResult<'_>, depth: u32, key_bytes: usize) {
             per_ray(c.backtracks, c),
             per_ray(c.hash_lookups(), c),
             per_ray(c.link_reads, c),
-            m.state_bytes(depth, key_bytes),
+            prepared.state_bytes(*m),
             if bad == 0 { "ok".to_string() } else { format!("MISMATCH on {bad} checks") }
         );
     }

@@ -252,6 +252,20 @@ impl PreparedScene {
         }
     }
 
+    /// Per-ray state of `method` in bytes ([`Method::state_bytes`]) for the depth of the tree it
+    /// traverses here (the binary tree's with its key width, the kd-tree's, or the wide tree's).
+    pub fn state_bytes(&self, method: Method) -> usize {
+        let depth = match method {
+            Method::Kd(_) => self.kd.as_ref().map(|k| k.tree.stats().depth),
+            Method::Wide(m) => match m.width() {
+                4 => self.wide4(m).ok().map(|t| t.stats().depth),
+                _ => self.wide8(m).ok().map(|t| t.stats().depth),
+            },
+            _ => None,
+        };
+        method.state_bytes(depth.unwrap_or(self.bvh.stats().depth), self.key_width().bytes())
+    }
+
     /// Bytes of the uncle layout (the BVH the hash overhead is relative to).
     pub fn bvh_bytes(&self) -> usize {
         self.uncles.as_ref().or(self.parents.as_ref()).map_or(0, BinaryLayout::bytes)

@@ -66,17 +66,40 @@ impl ChildKernel for FastKernel {
         ReferenceKernel::test(node, slab, tmin, tmax)
     }
 
+    /// The network over as few lanes as the hit children need: one hit needs none, two one
+    /// exchange, up to four the 4-lane network on the hits gathered into four lanes. The order is
+    /// total, so each gives what the full network gives.
     #[inline(always)]
     fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
         let n = hits.mask.count_ones() as usize;
-        if n <= 1 {
-            // One hit child needs no sorting: its slot is the lowest set bit.
-            order[0] = hits.mask.trailing_zeros();
-            return n;
+        let first = hits.mask.trailing_zeros();
+        match n {
+            0 | 1 => order[0] = first,
+            2 => {
+                let second = (hits.mask & (hits.mask - 1)).trailing_zeros();
+                let (a, b) = (hits.t_enter[first as usize], hits.t_enter[second as usize]);
+                // `first < second`, so a tie keeps them in slot order.
+                (order[0], order[1]) = if b < a { (second, first) } else { (first, second) };
+            }
+            3 | 4 if W > 4 => {
+                let (mut keys, mut slots) = ([f32::INFINITY; 4], [u32::MAX; 4]);
+                let mut m = hits.mask;
+                for k in 0..4 {
+                    if m != 0 {
+                        let slot = m.trailing_zeros();
+                        (keys[k], slots[k]) = (hits.t_enter[slot as usize], slot);
+                        m &= m - 1;
+                    }
+                }
+                sort_network(&mut keys, &mut slots);
+                order[..4].copy_from_slice(&slots);
+            }
+            _ => {
+                let (mut keys, mut slots) = sort_keys(hits);
+                sort_network(&mut keys, &mut slots);
+                *order = slots;
+            }
         }
-        let (mut keys, mut slots) = sort_keys(hits);
-        sort_network(&mut keys, &mut slots);
-        *order = slots;
         n
     }
 }
