@@ -26,12 +26,16 @@ USAGE:
       writes primary rays (Morton order) framing the scene, for `trace`
   raytrail bench [--scene FILE[,FILE...]] [--rays primary,shadow,diffuse,ao] [--width W] [--height H]
                [--passes N] [--threads N[,N...]] [--methods NAME,...|all|none] [--peers NAME,...|all|none]
-               [--baseline NAME] [--builder sah|ploc] [--ao-rays N] [--json FILE] [--plot FILE.svg]
+               [--baseline NAME] [--builder sah|ploc] [--ao-rays N] [--view outside|inside|both|auto]
+               [--json FILE] [--plot FILE.svg]
       times raytrail's methods and the peers (obvhs-bvh2, obvhs-cwbvh, bvh; each also as NAME+wt with
-      raytrail's watertight test) on the same rays on the same thread pool; prints Mrays/s (median of
-      N passes, default 5, after a warm-up), the ratio to the baseline (default obvhs-bvh2), work per
-      ray, build times, memory and hit agreement with the stack method. Defaults: 512 x 512 primary
-      rays, 4 ambient-occlusion rays per hit, 1 thread and all threads, every method and peer
+      raytrail's watertight test; embree, own test only, in a binary built with `--features embree`)
+      on the same rays on the same thread pool; prints Mrays/s (median of N passes, default 5, after
+      a warm-up), the ratio to the baseline (default obvhs-bvh2), work per ray, build times, memory
+      and hit agreement with the stack method. Views: the camera outside the scene framing it, or
+      inside it (low in its box, looking along the long side, 90-degree field of view); `auto` adds
+      the inside view where it sees a room. Defaults: 512 x 512 primary rays, 4 ambient-occlusion
+      rays per hit, 1 thread and all threads, every method and peer, --view auto
 
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
          kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree)

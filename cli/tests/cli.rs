@@ -100,3 +100,35 @@ fn bad_input_is_an_error_not_a_panic() {
         assert!(err.contains("error:") && !err.contains("panicked"), "{args:?}: {err}");
     }
 }
+
+/// `bench --peers embree`: with the `embree` feature, Embree is measured beside raytrail and its
+/// occlusion agrees with the stack method's; without it, a usage error says how to get it.
+#[test]
+fn bench_with_embree_needs_the_feature() {
+    let json = tmp("embree.json");
+    let out = bin()
+        .args(["bench", "--scene", "builtin", "--peers", "embree", "--baseline", "embree", "--methods", "stack"])
+        .args(["--rays", "primary,shadow", "--width", "32", "--height", "24", "--passes", "1", "--threads", "1"])
+        .args(["--no-gpu", "--view", "both", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    if !cfg!(feature = "embree") {
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains("built without the `embree` cargo feature"), "{stderr}");
+        return;
+    }
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("embree (default quality, rtcCommitScene)"), "{stdout}");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let scenes = doc["scenes"].as_array().unwrap();
+    assert_eq!(scenes.iter().map(|s| s["view"].as_str().unwrap()).collect::<Vec<_>>(), ["outside", "inside"]);
+    for scene in scenes {
+        for rays in scene["rays"].as_array().unwrap() {
+            let a = rays["agreement"].as_array().unwrap().iter().find(|a| a["target"] == "embree").unwrap();
+            let (n, close) = (a["rays"].as_f64().unwrap(), a["within_tolerance"].as_f64().unwrap());
+            assert!(close >= 0.99 * n, "{} {}: {a}", scene["name"], rays["type"]);
+        }
+    }
+}

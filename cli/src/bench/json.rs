@@ -1,6 +1,6 @@
 //! The run as JSON, through serde: one object per scene, per ray type, per row.
 //!
-//! Shape: `{command, baseline, passes, threads, scenes: [{name, triangles, width, height,
+//! Shape: `{command, baseline, passes, threads, scenes: [{name, view, triangles, width, height,
 //! builds: [{what, seconds, bytes: {part: n}}], rays: [{type, query, rays, rows: [{target, kind,
 //! threads, mrays_per_s, ratio, median_s, passes_s, nodes_per_ray, leaves_per_ray,
 //! tests_per_ray}], agreement: [{target, rays, exact, within_tolerance, classes: {class: n}}]}]}]}`.
@@ -41,6 +41,7 @@ struct Doc<'a> {
 #[derive(Serialize)]
 struct Scene<'a> {
     name: &'a str,
+    view: &'static str,
     triangles: usize,
     width: u32,
     height: u32,
@@ -52,6 +53,7 @@ impl<'a> From<&'a SceneReport> for Scene<'a> {
     fn from(s: &'a SceneReport) -> Self {
         Scene {
             name: &s.name,
+            view: s.view.name(),
             triangles: s.triangles,
             width: s.width,
             height: s.height,
@@ -161,6 +163,7 @@ fn classes_as_map<S: Serializer>(classes: &&BTreeMap<Class, usize>, s: S) -> Res
 mod tests {
     use super::super::rays::RayKind;
     use super::super::target::{TargetKind, Work};
+    use super::super::view::View;
     use super::*;
     use serde_json::{json, Value};
 
@@ -188,6 +191,7 @@ mod tests {
             threads: vec![1, 4],
             scenes: vec![SceneReport {
                 name: "dragon_vrip.ply.gz — ü".into(),
+                view: View::Inside,
                 triangles: 12,
                 width: 64,
                 height: 48,
@@ -225,6 +229,7 @@ mod tests {
         assert_eq!(doc["threads"], json!([1, 4]));
         let scene = &doc["scenes"][0];
         assert_eq!(scene["name"], "dragon_vrip.ply.gz — ü");
+        assert_eq!(scene["view"], "inside");
         assert_eq!((&scene["triangles"], &scene["width"], &scene["height"]), (&json!(12), &json!(64), &json!(48)));
         assert_eq!(
             scene["builds"],
@@ -251,7 +256,7 @@ mod tests {
     fn keys_keep_the_report_order() {
         let text = to_json(&report());
         let at = |key: &str| text.find(&format!("\"{key}\"")).unwrap_or_else(|| panic!("{key} missing"));
-        let order = ["command", "baseline", "passes", "threads", "scenes", "name", "builds", "rays", "rows"];
+        let order = ["command", "baseline", "passes", "threads", "scenes", "name", "view", "builds", "rays", "rows"];
         assert!(order.windows(2).all(|w| at(w[0]) < at(w[1])), "{text}");
         // Maps keep the report's order too (not sorted): "nodes" before "indices".
         assert!(at("nodes") < at("indices"));

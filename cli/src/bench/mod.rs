@@ -1,11 +1,13 @@
 //! `raytrail bench`: raytrail's methods against peer libraries (obvhs's BVH2 and CWBVH, the `bvh`
-//! crate) on the same rays, in the same process, on the same thread pools.
+//! crate, and Embree with the `embree` cargo feature) on the same rays, in the same process, on
+//! the same thread pools.
 //!
-//! Per scene: build raytrail's tree, layouts and tables and each peer's own tree; make primary,
-//! shadow, diffuse and ambient-occlusion rays once (the secondary rays from the stack method's
-//! primary hits); time every target at each thread count ([`measure`]); compare every target's
-//! hits with the stack method's ([`agreement`]). Then print tables ([`table`]) and optionally
-//! write JSON ([`json`]) and an SVG plot ([`plot`]).
+//! Per scene: build raytrail's tree, layouts and tables and each peer's own tree once; then per
+//! camera view ([`view`]: outside the scene, and inside it where it is a room) make primary,
+//! shadow, diffuse and ambient-occlusion rays (the secondary rays from the stack method's primary
+//! hits); time every target at each thread count ([`measure`]); compare every target's hits with
+//! the stack method's ([`agreement`]). Then print tables ([`table`]) and optionally write JSON
+//! ([`json`]) and an SVG plot ([`plot`]), one scene entry per view.
 
 mod agreement;
 mod json;
@@ -18,6 +20,7 @@ mod report;
 mod table;
 mod target;
 mod target_gpu;
+mod view;
 
 use crate::progress::{timed, Progress};
 use options::Options;
@@ -32,6 +35,7 @@ use report::{BenchReport, Built, SceneReport};
 use std::sync::Arc;
 use target::{BenchTarget, RaytrailCpu, Targets};
 use target_gpu::RaytrailGpu;
+use view::Enclosure;
 
 /// Runs `raytrail bench` with the arguments after the subcommand.
 pub fn main(args: &[String]) -> Result<i32, String> {
@@ -56,9 +60,8 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         .collect::<Result<Vec<_>, _>>()?;
     let mut scenes = Vec::new();
     for path in &opts.scenes {
-        let s = bench_scene(path, &opts, &pools)?;
-        table::print_scene(&s, &opts.baseline, opts.passes);
-        scenes.push(s);
+        let print = &mut |s: &SceneReport| table::print_scene(s, &opts.baseline, opts.passes);
+        scenes.extend(bench_scene(path, &opts, &pools, print)?);
     }
     let report = BenchReport {
         command: std::iter::once("raytrail bench".to_string())
@@ -85,8 +88,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
 fn check_baseline(opts: &Options) -> Result<(), String> {
     let mut names: Vec<String> = opts.methods.iter().map(|m| m.name().to_string()).collect();
     for p in &opts.peers {
-        names.push(p.clone());
-        names.push(format!("{p}+wt"));
+        names.extend(peers::target_names(p));
     }
     if names.contains(&opts.baseline) {
         Ok(())
@@ -95,8 +97,15 @@ fn check_baseline(opts: &Options) -> Result<(), String> {
     }
 }
 
-/// Loads, builds, makes rays and measures every target on one scene.
-fn bench_scene(path: &str, opts: &Options, pools: &[(usize, rayon::ThreadPool)]) -> Result<SceneReport, String> {
+/// Loads, builds, and per view of [`Options::view`] makes rays and measures every target on one
+/// scene; one report per view, in order, each also handed to `done` as soon as it is measured. The
+/// trees are built once and serve every view.
+fn bench_scene(
+    path: &str,
+    opts: &Options,
+    pools: &[(usize, rayon::ThreadPool)],
+    done: &mut dyn FnMut(&SceneReport),
+) -> Result<Vec<SceneReport>, String> {
     let (named, _) = timed(&format!("loading {path}"), || load_scene(path));
     let named = named?;
     let scene = &named.scene;
@@ -120,17 +129,6 @@ fn bench_scene(path: &str, opts: &Options, pools: &[(usize, rayon::ThreadPool)])
     let cpu = CpuScene(prepared);
 
     let stack = RaytrailCpu::new(Method::Bvh2(Bvh2Method::Stack), cpu.clone());
-    let primary = rays::primary_rays(scene, opts.width, opts.height);
-    let mut primary_hits = vec![Hit::MISS; primary.len()];
-    stack.trace(largest, &primary, Query::Closest, &mut primary_hits)?;
-    let batches = rays::batches(&opts.rays, scene, &primary, &primary_hits, opts.ao_rays);
-    let mut references = Vec::with_capacity(batches.len());
-    for b in &batches {
-        let mut hits = vec![Hit::MISS; b.rays.len()];
-        stack.trace(largest, &b.rays, b.kind.query(), &mut hits)?;
-        references.push(hits);
-    }
-
     let mut targets: Targets =
         opts.methods.iter().map(|&m| Box::new(RaytrailCpu::new(m, cpu.clone())) as Box<dyn BenchTarget>).collect();
     targets.extend(gpu_targets(opts, &cpu)?);
@@ -146,20 +144,50 @@ fn bench_scene(path: &str, opts: &Options, pools: &[(usize, rayon::ThreadPool)])
         baseline: &opts.baseline,
         triangles: scene.triangles(),
     };
-    let mut progress = Progress::new(&format!("bench {}", named.name), plan.steps_per_batch() * batches.len());
-    let mut reports = Vec::with_capacity(batches.len());
-    for (b, reference) in batches.iter().zip(&references) {
-        reports.push(plan.run(b, reference, &mut progress)?);
+    let mut reports = Vec::new();
+    for &view in opts.view.views() {
+        let primary = rays::primary_rays(scene, view, opts.width, opts.height);
+        let mut primary_hits = vec![Hit::MISS; primary.len()];
+        stack.trace(largest, &primary, Query::Closest, &mut primary_hits)?;
+        let enclosure = Enclosure::of(&primary, &primary_hits, scene.triangles());
+        if !opts.view.keeps(view, &enclosure) {
+            println!(
+                "  {} view of {}: skipped, not a room ({:.1}% of its primary rays hit, {:.1}% of those a front side; \
+                 --view both measures it anyway)",
+                view.name(),
+                named.name,
+                100.0 * enclosure.hits,
+                100.0 * enclosure.front
+            );
+            continue;
+        }
+        let batches = rays::batches(&opts.rays, scene, &primary, &primary_hits, opts.ao_rays);
+        let mut references = Vec::with_capacity(batches.len());
+        for b in &batches {
+            let mut hits = vec![Hit::MISS; b.rays.len()];
+            stack.trace(largest, &b.rays, b.kind.query(), &mut hits)?;
+            references.push(hits);
+        }
+        let name = view.label(&named.name);
+        let mut progress = Progress::new(&format!("bench {name}"), plan.steps_per_batch() * batches.len());
+        let mut rays = Vec::with_capacity(batches.len());
+        for (b, reference) in batches.iter().zip(&references) {
+            rays.push(plan.run(b, reference, &mut progress)?);
+        }
+        progress.finish();
+        let report = SceneReport {
+            name,
+            view,
+            triangles: scene.triangles().len(),
+            width: opts.width,
+            height: opts.height,
+            builds: builds.clone(),
+            rays,
+        };
+        done(&report);
+        reports.push(report);
     }
-    progress.finish();
-    Ok(SceneReport {
-        name: named.name.clone(),
-        triangles: scene.triangles().len(),
-        width: opts.width,
-        height: opts.height,
-        builds,
-        rays: reports,
-    })
+    Ok(reports)
 }
 
 /// raytrail's build steps and the memory of each part it derived.
@@ -225,36 +253,63 @@ fn gpu_targets(opts: &Options, cpu: &CpuScene) -> Result<Targets, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use view::View;
 
     #[test]
     fn a_tiny_run_measures_every_target_and_agrees() {
         let args: Vec<String> =
-            "--width 24 --height 16 --passes 1 --threads 1 --methods stack,hash,kd-stack --ao-rays 2 --builder ploc --no-gpu"
+            "--width 24 --height 16 --passes 1 --threads 1 --methods stack,hash,kd-stack --ao-rays 2 --builder ploc --no-gpu --view both"
                 .split_whitespace()
                 .map(str::to_string)
                 .collect();
         let opts = Options::parse(&args).unwrap();
         let pools = vec![(1, rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap())];
-        let s = bench_scene("builtin", &opts, &pools).unwrap();
-        assert_eq!(s.rays.len(), 4);
-        assert!(s.builds.iter().any(|b| b.what.starts_with("obvhs-cwbvh")));
-        for r in &s.rays {
-            // 3 methods, 3 peers with 2 variants each.
-            assert_eq!(r.rows.len(), 9, "{}", r.kind.name());
-            assert!(r.rows.iter().all(|row| row.mrays_per_s > 0.0 && row.passes.len() == 1));
-            assert!(r.rows.iter().filter(|row| row.target == "obvhs-bvh2").all(|row| row.ratio == Some(1.0)));
-            for (name, a) in &r.agreement {
-                let min = if name.ends_with("+wt") {
-                    99.0
-                } else if raytrail_method(name) {
-                    100.0
-                } else {
-                    0.0
-                };
-                assert!(a.exact_pct() >= min, "{} {name}: {:.2}%", r.kind.name(), a.exact_pct());
+        let mut printed = Vec::new();
+        let views = bench_scene("builtin", &opts, &pools, &mut |s| printed.push(s.name.clone())).unwrap();
+        assert_eq!(views.iter().map(|s| s.view).collect::<Vec<_>>(), [View::Outside, View::Inside]);
+        assert_eq!(printed, views.iter().map(|s| s.name.clone()).collect::<Vec<_>>());
+        assert!(views[1].name.ends_with(" (inside)") && !views[0].name.contains("inside"));
+        // 3 methods, 3 peers with 2 variants each, and Embree (own test only) with its feature.
+        let rows = if cfg!(feature = "embree") { 10 } else { 9 };
+        for s in &views {
+            assert_eq!(s.rays.len(), 4);
+            assert!(s.builds.iter().any(|b| b.what.starts_with("obvhs-cwbvh")));
+            assert_eq!(s.builds.iter().any(|b| b.what.starts_with("embree")), cfg!(feature = "embree"));
+            for r in &s.rays {
+                assert_eq!(r.rows.len(), rows, "{} {}", s.name, r.kind.name());
+                assert!(r.rows.iter().all(|row| row.mrays_per_s > 0.0 && row.passes.len() == 1));
+                assert!(r.rows.iter().filter(|row| row.target == "obvhs-bvh2").all(|row| row.ratio == Some(1.0)));
+                for (name, a) in &r.agreement {
+                    let min = if name.ends_with("+wt") {
+                        99.0
+                    } else if raytrail_method(name) {
+                        100.0
+                    } else {
+                        0.0
+                    };
+                    assert!(a.exact_pct() >= min, "{} {} {name}: {:.2}%", s.name, r.kind.name(), a.exact_pct());
+                }
             }
         }
-        assert!(bench_scene("no/such/scene.obj", &opts, &pools).is_err());
+        assert!(bench_scene("no/such/scene.obj", &opts, &pools, &mut |_| {}).is_err());
+        // From inside, the sphereflake's eye is within its big sphere: no room, so `auto` (the
+        // default) measures the outside view only.
+        let args: Vec<String> = args.iter().take_while(|a| *a != "--view").cloned().collect();
+        let opts = Options::parse(&args).unwrap();
+        let views = bench_scene("builtin", &opts, &pools, &mut |_| {}).unwrap();
+        assert_eq!(views.iter().map(|s| s.view).collect::<Vec<_>>(), [View::Outside]);
+    }
+
+    #[test]
+    fn the_baseline_must_be_measured() {
+        let parse = |s: &str| Options::parse(&s.split_whitespace().map(str::to_string).collect::<Vec<_>>()).unwrap();
+        assert!(check_baseline(&parse("--peers bvh --baseline bvh+wt")).is_ok());
+        assert!(check_baseline(&parse("--peers bvh --baseline obvhs-bvh2")).is_err());
+        if cfg!(feature = "embree") {
+            assert!(check_baseline(&parse("--peers embree --baseline embree")).is_ok());
+            // Embree has no watertight variant.
+            assert!(check_baseline(&parse("--peers embree --baseline embree+wt")).is_err());
+        }
     }
 
     /// Whether `name` is one of raytrail's methods.

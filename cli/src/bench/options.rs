@@ -1,6 +1,7 @@
 //! The `raytrail bench` flags, parsed and checked before any work starts.
 
 use super::rays::RayKind;
+use super::view::ViewChoice;
 use crate::args::Args;
 use raytrail::core::method::Method;
 use raytrail::{Builder, BUILTIN_SCENE};
@@ -8,13 +9,14 @@ use raytrail::{Builder, BUILTIN_SCENE};
 /// Every flag `raytrail bench` knows.
 const FLAGS: &[&str] = &[
     "scene", "rays", "width", "height", "passes", "threads", "methods", "peers", "baseline", "json", "plot", "builder",
-    "ao-rays", "no-gpu",
+    "ao-rays", "no-gpu", "view",
 ];
 
 /// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
 /// follow from the primary hits). With the three scenes of BENCHMARKS.md (Sponza, the kitchen, the
-/// full dragon), every target at 1 and 2 threads, the run takes about five minutes on the project's
-/// shared 2-core machine.
+/// full dragon), every target at 1 and 2 threads, the run took about five minutes on the project's
+/// shared 2-core machine with the outside view alone (`--view outside`); the default `--view auto`
+/// adds the inside views of Sponza and the kitchen.
 pub const DEFAULT_SIZE: u32 = 512;
 
 /// Default number of timed passes: the median of five rides out most of the shared machine's noise.
@@ -23,8 +25,12 @@ pub const DEFAULT_PASSES: usize = 5;
 /// Default number of ambient-occlusion rays per primary hit.
 pub const DEFAULT_AO_RAYS: usize = 4;
 
-/// The peers a run can include, by command-line name.
-pub const PEERS: [&str; 3] = ["obvhs-bvh2", "obvhs-cwbvh", "bvh"];
+/// The peers a run can include, by command-line name (`embree` with the `embree` cargo feature).
+#[cfg(not(feature = "embree"))]
+pub const PEERS: &[&str] = &["obvhs-bvh2", "obvhs-cwbvh", "bvh"];
+/// The peers a run can include, by command-line name (`embree` with the `embree` cargo feature).
+#[cfg(feature = "embree")]
+pub const PEERS: &[&str] = &["obvhs-bvh2", "obvhs-cwbvh", "bvh", "embree"];
 
 /// What to measure, and where to write it.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,6 +63,8 @@ pub struct Options {
     pub ao_rays: usize,
     /// Leave the GPU out even when wgpu finds an adapter.
     pub no_gpu: bool,
+    /// Which camera views each scene is measured from.
+    pub view: ViewChoice,
 }
 
 impl Options {
@@ -107,6 +115,12 @@ impl Options {
             Some(v) => {
                 let given = unique(list(v));
                 if let Some(bad) = given.iter().find(|p| !PEERS.contains(&p.as_str())) {
+                    if bad == "embree" {
+                        return Err("--peers: 'embree' is not available: this raytrail binary was built without the \
+                                    `embree` cargo feature (rebuild with `--features embree`, which links the \
+                                    system's libembree3)"
+                            .to_string());
+                    }
                     return Err(format!("--peers: unknown peer '{bad}' (known: {}, all, none)", PEERS.join(", ")));
                 }
                 given
@@ -167,6 +181,7 @@ impl Options {
             builder: Builder::from_name(a.get("builder").unwrap_or("sah"))?,
             ao_rays,
             no_gpu: a.has("no-gpu"),
+            view: ViewChoice::from_name(a.get("view").unwrap_or(ViewChoice::DEFAULT.name()))?,
         })
     }
 }
@@ -201,9 +216,11 @@ mod tests {
         let o = parse("").unwrap();
         assert_eq!(o.scenes, vec!["builtin"]);
         assert_eq!(o.rays, RayKind::ALL.to_vec());
-        assert_eq!(o.methods.len(), 12);
+        assert_eq!(o.methods, Method::ALL.to_vec());
         assert_eq!(o.baseline, "obvhs-bvh2");
         assert_eq!(o.threads[0], 1);
+        assert_eq!(o.view, ViewChoice::DEFAULT);
+        assert_eq!(parse("--view both").unwrap().view, ViewChoice::Both);
         let e = parse("--scene a.obj --colour red").unwrap_err();
         assert!(e.contains("unknown flag --colour"), "{e}");
         let o = parse("--scene a.obj,,b.ply --rays ao,primary,ao --threads 2,1,2 --methods hash,stack").unwrap();
@@ -225,7 +242,8 @@ mod tests {
         for bad in [
             "--rays sideways",
             "--methods fastest",
-            "--peers embree",
+            "--peers bvh,fastest",
+            "--view above",
             "--threads 0",
             "--passes 0",
             "--width 0",
@@ -235,5 +253,21 @@ mod tests {
         ] {
             assert!(parse(bad).is_err(), "{bad} was accepted");
         }
+    }
+
+    #[cfg(not(feature = "embree"))]
+    #[test]
+    fn embree_needs_the_feature() {
+        let e = parse("--peers obvhs-bvh2,embree").unwrap_err();
+        assert!(e.contains("built without the `embree` cargo feature"), "{e}");
+        assert!(!parse("--peers all").unwrap().peers.contains(&"embree".to_string()));
+    }
+
+    #[cfg(feature = "embree")]
+    #[test]
+    fn embree_is_a_peer_with_the_feature() {
+        assert_eq!(parse("--peers embree").unwrap().peers, vec!["embree"]);
+        assert!(parse("--peers all").unwrap().peers.contains(&"embree".to_string()));
+        assert!(parse("--peers embree --baseline embree").is_ok());
     }
 }

@@ -309,6 +309,7 @@ mod tests {
             threads: vec![1, 2],
             scenes: vec![SceneReport {
                 name: "tiny & small".to_string(),
+                view: super::super::view::View::Outside,
                 triangles: 2,
                 width: 10,
                 height: 10,

@@ -1,10 +1,12 @@
 //! The bench's ray types, made once per scene: primary, shadow, diffuse and ambient occlusion.
 //!
 //! Primary, shadow and diffuse rays come from the conformance suite's generators; the
-//! ambient-occlusion generator lives here.
+//! ambient-occlusion generator lives here. Primary rays come from one camera [`View`] of the
+//! scene; the other kinds follow from their hits, so each view gets its own four sets.
 
+use super::view::View;
 use glam::Vec3;
-use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
+use raytrail::conformance::rays::{default_light, diffuse, primary_from, scene_epsilon, shadow, RAY_SEED};
 use raytrail::conformance::rng::Pcg32;
 use raytrail::core::method::Query;
 use raytrail::core::scene::Scene;
@@ -90,9 +92,10 @@ pub fn batches(
         .collect()
 }
 
-/// Primary rays framing `scene` (Morton order), as the conformance suite makes them.
-pub fn primary_rays(scene: &Scene, width: u32, height: u32) -> Vec<Ray> {
-    primary(scene, width, height)
+/// Primary rays of `view` of `scene` (Morton order), as the conformance suite makes them; from
+/// outside, the conformance suite's own primary rays.
+pub fn primary_rays(scene: &Scene, view: View, width: u32, height: u32) -> Vec<Ray> {
+    primary_from(&view.camera(scene.bounds()), width, height)
 }
 
 /// `per_hit` ambient-occlusion rays per hit of `rays` (misses, non-finite hits and zero-area
@@ -181,6 +184,16 @@ mod tests {
         let below = [Ray::new(Vec3::new(0.5, 0.3, -2.0), Vec3::Z, 0.0, f32::INFINITY)];
         let ao = ambient_occlusion(&below, &[Hit { t: 2.0, prim: 1, u: 0.2, v: 0.2 }], &scene, 8, 1);
         assert!(ao.iter().all(|r| r.dir[2] <= 0.0 && r.origin[2] < 0.0));
+    }
+
+    #[test]
+    fn the_outside_view_is_the_conformance_framing() {
+        let scene = floor();
+        assert_eq!(primary_rays(&scene, View::Outside, 8, 6), raytrail::conformance::rays::primary(&scene, 8, 6));
+        let inside = primary_rays(&scene, View::Inside, 8, 6);
+        assert_eq!(inside.len(), 48);
+        let eye = View::Inside.camera(scene.bounds()).eye;
+        assert!(inside.iter().all(|r| r.origin() == eye));
     }
 
     #[test]

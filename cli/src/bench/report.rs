@@ -4,6 +4,7 @@
 use super::agreement::Agreement;
 use super::rays::RayKind;
 use super::target::{TargetKind, Work};
+use super::view::View;
 
 /// One build step: what was built, how long it took, and the memory it holds.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,8 +54,10 @@ pub struct RayReport {
 /// Everything measured on one scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneReport {
-    /// Scene name (file name).
+    /// Scene name (file name; " (inside)" added for the inside view).
     pub name: String,
+    /// Where the camera stood.
+    pub view: View,
     /// Triangles.
     pub triangles: usize,
     /// Primary image size.

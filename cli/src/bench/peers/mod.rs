@@ -5,8 +5,13 @@
 //! any-hit callback, so that differences from the triangle test and from the traversal are told
 //! apart. The watertight variants also keep raytrail's closest-hit tie rule (equal `t`: smaller
 //! primitive id) and its inclusive interval, so their hits can match raytrail's bit for bit.
+//!
+//! Embree (with the `embree` cargo feature) is traced with its own test only: its traversal takes
+//! no per-triangle callback short of a user geometry, which would not be Embree's fast path.
 
 mod bvh_crate;
+#[cfg(feature = "embree")]
+mod embree;
 mod obvhs;
 
 use super::report::Built;
@@ -49,11 +54,26 @@ pub fn build(names: &[String], scene: &Scene, pool: &rayon::ThreadPool) -> Resul
             "obvhs-bvh2" => both_variants(name, pool.install(|| obvhs::ObvhsScene::bvh2(scene)), &mut targets),
             "obvhs-cwbvh" => both_variants(name, pool.install(|| obvhs::ObvhsScene::cwbvh(scene)), &mut targets),
             "bvh" => both_variants(name, pool.install(|| bvh_crate::BvhScene::new(scene)), &mut targets),
+            #[cfg(feature = "embree")]
+            "embree" => {
+                let (target, built) = embree::Embree::new(scene, pool.current_num_threads())?;
+                targets.push(Box::new(target));
+                built
+            }
             other => return Err(format!("unknown peer '{other}'")),
         };
         built.push(b);
     }
     Ok((targets, built))
+}
+
+/// The target names a peer adds: its own test and, where it has one, the watertight variant.
+pub fn target_names(peer: &str) -> Vec<String> {
+    let mut names = vec![peer.to_string()];
+    if peer != "embree" {
+        names.push(format!("{peer}{}", Variant::Watertight.suffix()));
+    }
+    names
 }
 
 /// Adds the two targets of a built peer tree (its own test, then raytrail's watertight one);

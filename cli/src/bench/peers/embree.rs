@@ -1,0 +1,204 @@
+//! Embree 3 (Intel's ray-tracing kernels; the system's `libembree3`, 3.13.5 on Debian), through
+//! the `embree3` crate's bindings, behind the `embree` cargo feature.
+//!
+//! The scene is one triangle geometry holding the scene's triangles in file order, each with its
+//! own three vertices (no sharing), so Embree's primitive id is raytrail's. It is built with
+//! Embree's defaults: no scene flags (not `ROBUST`), the default (medium) build quality, on a
+//! device with as many build threads as the bench's largest pool. The build time is that of
+//! `rtcCommitScene`; the memory is what Embree's memory monitor reports while the buffers are
+//! made and while the scene is committed.
+//!
+//! Tracing is one ray at a time (`rtcIntersect1`, `rtcOccluded1`) with a default intersection
+//! context, in the same chunks on the same rayon pool as the other peers. Closest hits come with
+//! `t`, primitive id and Embree's `u`, `v` (the weights of the second and third vertex, as
+//! raytrail's). An occlusion query reports only whether something was hit, so an any hit has
+//! an unknown primitive ([`UNKNOWN_PRIM`]) and `t` (NaN); the agreement compares occlusion only.
+//!
+//! Embree's own hit rule, as seen on test rays: a hit at `t = tmax` counts, one at `t = tmin`
+//! does not. Embree has no callback-free way to count triangle tests, so its work is not
+//! reported, and there is no `+wt` variant (raytrail's test would need a user geometry).
+
+use super::par_trace;
+use crate::bench::report::Built;
+use crate::bench::target::{BenchTarget, TargetKind, Work};
+use embree3::{
+    BufferUsage, Config, Device, Format, GeometryKind, IntersectContext, Ray as EmbreeRay, RayHit, Scene as EmbreeScene,
+};
+use raytrail::core::method::Query;
+use raytrail::core::scene::Scene;
+use raytrail::core::{Hit, Ray};
+use std::sync::atomic::{AtomicIsize, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Primitive id of an any hit, which Embree's occlusion query does not report.
+pub const UNKNOWN_PRIM: u32 = Hit::NO_PRIM - 1;
+
+/// An Embree scene over a raytrail scene: a bench target.
+pub struct Embree {
+    scene: EmbreeScene<'static>,
+}
+
+impl Embree {
+    /// Builds the Embree scene over `scene` with `threads` build threads; returns it and what the
+    /// build cost.
+    pub fn new(scene: &Scene, threads: usize) -> Result<(Self, Built), String> {
+        let fail = |what: &str, e: embree3::Error| format!("embree: {what}: {e:?}");
+        let config = Config { threads: u32::try_from(threads).unwrap_or(0), ..Config::default() };
+        let device = Device::with_config(config).map_err(|e| fail("cannot create a device", e))?;
+        let allocated = Arc::new(AtomicIsize::new(0));
+        let counter = allocated.clone();
+        device.set_memory_monitor_function(move |bytes, _| {
+            counter.fetch_add(bytes, Ordering::Relaxed);
+            true
+        });
+        let tris = scene.triangles();
+        let mut geometry =
+            device.create_geometry(GeometryKind::TRIANGLE).map_err(|e| fail("cannot create a geometry", e))?;
+        {
+            let mut vertices = geometry
+                .set_new_buffer::<[f32; 3]>(BufferUsage::VERTEX, 0, Format::FLOAT3, 12, 3 * tris.len())
+                .map_err(|e| fail("cannot make the vertex buffer", e))?;
+            for (out, t) in vertices.chunks_exact_mut(3).zip(tris) {
+                for (o, v) in out.iter_mut().zip(&t.v) {
+                    *o = v.to_array();
+                }
+            }
+        }
+        {
+            let mut indices = geometry
+                .set_new_buffer::<[u32; 3]>(BufferUsage::INDEX, 0, Format::UINT3, 12, tris.len())
+                .map_err(|e| fail("cannot make the index buffer", e))?;
+            for (i, out) in indices.iter_mut().enumerate() {
+                let k = 3 * i as u32;
+                *out = [k, k + 1, k + 2];
+            }
+        }
+        let buffer_bytes = allocated.load(Ordering::Relaxed);
+        let geometry = geometry.commit();
+        let mut embree = device.create_scene().map_err(|e| fail("cannot create a scene", e))?;
+        embree.attach_geometry(&geometry);
+        let before_commit = allocated.load(Ordering::Relaxed);
+        let start = Instant::now();
+        embree.commit();
+        let seconds = start.elapsed().as_secs_f64();
+        let bvh_bytes = allocated.load(Ordering::Relaxed) - before_commit;
+        device.unset_memory_monitor_function();
+        let error = device.get_error();
+        if error != embree3::Error::NONE {
+            return Err(fail("the build failed", error));
+        }
+        let bytes = [("vertex and index buffers", buffer_bytes), ("BVH (memory monitor)", bvh_bytes)]
+            .into_iter()
+            .map(|(what, n)| (what.to_string(), usize::try_from(n).unwrap_or(0)))
+            .collect();
+        let built = Built { what: "embree (default quality, rtcCommitScene)".to_string(), seconds, bytes };
+        Ok((Self { scene: embree }, built))
+    }
+
+    /// Closest hit of one ray (`rtcIntersect1`).
+    #[inline(always)]
+    fn closest(&self, r: &Ray) -> Hit {
+        let mut rh = RayHit::from(EmbreeRay::segment(r.origin, r.dir, r.tmin, r.tmax));
+        self.scene.intersect(&mut IntersectContext::incoherent(), &mut rh);
+        if rh.hit.is_valid() {
+            Hit { t: rh.ray.tfar, prim: rh.hit.primID, u: rh.hit.u, v: rh.hit.v }
+        } else {
+            Hit::MISS
+        }
+    }
+
+    /// Whether one ray hits anything (`rtcOccluded1`).
+    #[inline(always)]
+    fn any(&self, r: &Ray) -> Hit {
+        let mut ray = EmbreeRay::segment(r.origin, r.dir, r.tmin, r.tmax);
+        if self.scene.occluded(&mut IntersectContext::incoherent(), &mut ray) {
+            Hit { t: f32::NAN, prim: UNKNOWN_PRIM, u: 0.0, v: 0.0 }
+        } else {
+            Hit::MISS
+        }
+    }
+}
+
+impl BenchTarget for Embree {
+    fn name(&self) -> &str {
+        "embree"
+    }
+
+    fn kind(&self) -> TargetKind {
+        TargetKind::PeerOwnTest
+    }
+
+    fn trace(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<(), String> {
+        match query {
+            Query::Closest => par_trace(pool, rays, hits, |r| (self.closest(r), 0)),
+            Query::Any => par_trace(pool, rays, hits, |r| (self.any(r), 0)),
+        }
+        .map(|_| ())
+    }
+
+    fn work(&self, _: &rayon::ThreadPool, _: &[Ray], _: Query) -> Result<Option<Work>, String> {
+        Ok(None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bench::agreement::compare;
+    use raytrail::conformance::rays::{primary, shadow};
+    use raytrail::core::method::{Bvh2Method, Method};
+    use raytrail::core::prepared::PreparedScene;
+    use raytrail::core::trace::{Trace, TraceOptions};
+    use raytrail::cpu::{CpuBackend, CpuScene};
+    use raytrail::{load_scene, Builder};
+
+    /// The stack method's hits on `rays`.
+    fn stack_hits(scene: &Scene, rays: &[Ray], query: Query) -> Vec<Hit> {
+        let bvh = Builder::Sah.build(scene).unwrap();
+        let method = Method::Bvh2(Bvh2Method::Stack);
+        let prepared = PreparedScene::new(scene, bvh, &[method]).unwrap();
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let opts = TraceOptions::new(method).query(query);
+        CpuBackend::new().trace(&CpuScene(Arc::new(prepared)), rays, &opts, &mut hits).unwrap();
+        hits
+    }
+
+    #[test]
+    fn embree_agrees_with_the_stack_method() {
+        let named = load_scene("builtin").unwrap();
+        let scene = &named.scene;
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let (embree, built) = Embree::new(scene, 2).unwrap();
+        assert!(built.seconds >= 0.0);
+        assert!(built.bytes.iter().all(|(_, n)| *n > 0), "{:?}", built.bytes);
+        assert_eq!(embree.name(), "embree");
+
+        let rays = primary(scene, 64, 48);
+        let expected = stack_hits(scene, &rays, Query::Closest);
+        let mut got = vec![Hit::MISS; rays.len()];
+        embree.trace(&pool, &rays, Query::Closest, &mut got).unwrap();
+        let hits = expected.iter().filter(|h| h.is_hit()).count();
+        assert!(hits > rays.len() / 10, "the camera sees the scene: {hits} hits");
+        // Same primitive and t within the bench's tolerance on nearly every ray; the rest are
+        // hits on shared edges or near-ties, which a different triangle test may resolve apart.
+        let a = compare(Query::Closest, &rays, &expected, &got, scene.triangles());
+        assert!(a.close_pct() >= 99.5, "{:.3}% within tolerance: {:?}", a.close_pct(), a.classes);
+        for (g, e) in got.iter().zip(&expected) {
+            if g.is_hit() && g.prim == e.prim {
+                assert!((g.u - e.u).abs() < 1e-3 && (g.v - e.v).abs() < 1e-3, "{g:?} vs {e:?}");
+            }
+        }
+
+        let bounds = scene.bounds();
+        let light = bounds.center() + glam::Vec3::new(0.0, 2.0, 0.5) * bounds.extent().length();
+        let shadows = shadow(&rays, &expected, light, raytrail::conformance::rays::scene_epsilon(bounds));
+        let expected = stack_hits(scene, &shadows, Query::Any);
+        let mut got = vec![Hit::MISS; shadows.len()];
+        embree.trace(&pool, &shadows, Query::Any, &mut got).unwrap();
+        let a = compare(Query::Any, &shadows, &expected, &got, scene.triangles());
+        assert!(a.exact_pct() >= 99.5, "{:.3}% same occlusion: {:?}", a.exact_pct(), a.classes);
+        assert!(got.iter().any(|h| h.is_hit()) && got.iter().any(|h| !h.is_hit()));
+        assert!(got.iter().filter(|h| h.is_hit()).all(|h| h.prim == UNKNOWN_PRIM));
+    }
+}
