@@ -38,7 +38,8 @@ USAGE:
       rays per hit, 1 thread and all threads, every method and peer, --view auto
 
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
-         kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree)
+         kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree);
+         bvh4, bvh8, bvh4-naive (wide BVH)
 SCENES:  OBJ, PLY (ASCII or binary), optionally gzip-compressed; `builtin` is a generated sphereflake";
 
 fn main() {

@@ -12,7 +12,7 @@ use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
-use raytrail_core::wide::{ReferenceKernel, WideBvh, WideSliceMemory};
+use raytrail_core::wide::{ReferenceKernel, WideSliceMemory};
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 use std::time::Instant;
@@ -77,8 +77,8 @@ impl SerialBackend {
             Method::Wide(m) => {
                 let root = scene.wide_root(m)?;
                 match m.width() {
-                    4 => Ok(Self::wide::<_, T>(&Self::wide_memory(scene.wide4(m)?), root, rays, query)),
-                    _ => Ok(Self::wide::<_, T>(&Self::wide_memory(scene.wide8(m)?), root, rays, query)),
+                    4 => Ok(Self::wide::<_, T>(&scene.wide4(m)?.memory(), root, rays, query)),
+                    _ => Ok(Self::wide::<_, T>(&scene.wide8(m)?.memory(), root, rays, query)),
                 }
             }
             other => Err(Error::Unsupported { method: other.name(), by: "the serial reference backend" }),
@@ -87,10 +87,6 @@ impl SerialBackend {
 }
 
 impl SerialBackend {
-    fn wide_memory<const W: usize>(tree: &WideBvh<W>) -> WideSliceMemory<'_, W> {
-        WideSliceMemory { nodes: tree.nodes(), triangles: tree.triangles(), prims: tree.prims() }
-    }
-
     /// Wide trees with the reference kernel (one child box at a time, an insertion sort): the
     /// scalar traversal every fast path's enumeration must equal.
     fn wide<const W: usize, T: TriangleTest>(

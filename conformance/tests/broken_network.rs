@@ -14,7 +14,7 @@ use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
 use raytrail_core::wide::network::sort_network_without;
 use raytrail_core::wide::traverse::trace_wide_ray;
-use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideBvh, WideNode, WideSliceMemory};
+use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideNode};
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 
@@ -22,6 +22,8 @@ use std::sync::Arc;
 struct DroppedExchange<const D: usize>;
 
 impl<const D: usize> ChildKernel for DroppedExchange<D> {
+    const BLOCKS: bool = true;
+
     fn test<const W: usize>(
         node: &WideNode<W>,
         slab: &raytrail_core::intersect::SlabRay,
@@ -40,10 +42,6 @@ impl<const D: usize> ChildKernel for DroppedExchange<D> {
 
 /// A backend of the wide methods alone, with the faulty network.
 struct Faulty<const D: usize>;
-
-fn memory<const W: usize>(t: &WideBvh<W>) -> WideSliceMemory<'_, W> {
-    WideSliceMemory { nodes: t.nodes(), triangles: t.triangles(), prims: t.prims() }
-}
 
 impl<const D: usize> Trace for Faulty<D> {
     type Prepared = Arc<PreparedScene>;
@@ -71,14 +69,14 @@ impl<const D: usize> Trace for Faulty<D> {
             let mut o = Both(Counters::default(), Recorder::default());
             *hit = match m.width() {
                 4 => trace_wide_ray::<4, _, Watertight, DroppedExchange<D>, _>(
-                    &memory(scene.wide4(m)?),
+                    &scene.wide4(m)?.memory(),
                     root,
                     ray,
                     opts.query,
                     &mut o,
                 ),
                 _ => trace_wide_ray::<8, _, Watertight, DroppedExchange<D>, _>(
-                    &memory(scene.wide8(m)?),
+                    &scene.wide8(m)?.memory(),
                     root,
                     ray,
                     opts.query,

@@ -17,7 +17,13 @@ fn check<const W: usize>(bvh: &Bvh2, wide: &WideBvh<W>) -> Vec<u32> {
         match c {
             WideChild::Leaf { first, count } => {
                 let id = wide.canonical_id(c.node_ref()).expect("a leaf names a binary leaf");
-                assert_eq!(bvh.nodes()[id as usize].kind, NodeKind::Leaf { first, count }, "leaf {id} kept whole");
+                let NodeKind::Leaf { first: b_first, count: b_count } = bvh.nodes()[id as usize].kind else {
+                    panic!("wide leaf {first} names binary node {id}, not a leaf")
+                };
+                assert_eq!(first % 4, 0, "leaf {id} starts a block");
+                assert_eq!(count, b_count, "leaf {id} kept whole");
+                let (w, b) = (first as usize, b_first as usize);
+                assert_eq!(&wide.prims()[w..w + count as usize], &bvh.prim_order()[b..b + count as usize], "leaf {id}");
                 leaves.push(id);
             }
             WideChild::Node(n) => {

@@ -8,7 +8,7 @@ use raytrail_core::observe::{Both, Counters, NoObserver, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::traverse::{trace_wide_batch, trace_wide_ray, WideRoot};
-use raytrail_core::wide::{FastKernel, WideBvh, WideSliceMemory};
+use raytrail_core::wide::{FastKernel, WideSliceMemory};
 use raytrail_core::Error;
 
 /// Traces one chunk with `method`; returns its counters.
@@ -20,13 +20,9 @@ pub(crate) fn trace_chunk(
 ) -> Result<Counters, Error> {
     let root = scene.wide_root(method)?;
     match method.width() {
-        4 => go(scene, method, opts, &memory(scene.wide4(method)?), root, chunk),
-        _ => go(scene, method, opts, &memory(scene.wide8(method)?), root, chunk),
+        4 => go(scene, method, opts, &scene.wide4(method)?.memory(), root, chunk),
+        _ => go(scene, method, opts, &scene.wide8(method)?.memory(), root, chunk),
     }
-}
-
-fn memory<const W: usize>(tree: &WideBvh<W>) -> WideSliceMemory<'_, W> {
-    WideSliceMemory { nodes: tree.nodes(), triangles: tree.triangles(), prims: tree.prims() }
 }
 
 fn go<const W: usize>(

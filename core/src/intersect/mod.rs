@@ -3,6 +3,7 @@
 //! Per-ray constants (reciprocal direction, octant, shear) are computed once per ray by
 //! [`RayContext::new`], in one place, so that every method and backend makes the same decisions.
 
+mod block;
 mod context;
 mod moller_trumbore;
 mod slab;
@@ -11,6 +12,7 @@ mod slab_pair;
 pub(crate) mod test_values;
 mod watertight;
 
+pub use block::{TriangleBlock, BLOCK};
 pub use context::{BoxConstants, KdRayContext, NoPair, RayContext, RELIABLE_LIMIT, SLACK_SCALE, SLACK_ULPS};
 pub use moller_trumbore::MollerTrumbore;
 pub use slab::{BoxHit, SlabRay, FAR_PAD};
@@ -47,5 +49,20 @@ pub trait TriangleTest: Copy + Default + Send + Sync + 'static {
     fn intersect_in_place(ray: &Self::PerRay, v: [&[f32; 3]; 3], tmin: f32, tmax: f32) -> Option<TriangleHit> {
         let [a, b, c] = v.map(|p| Vec3::from_array(*p));
         Self::intersect(ray, a, b, c, tmin, tmax)
+    }
+    /// The four triangles of `block` against one interval, each lane's answer what
+    /// [`TriangleTest::intersect_in_place`] gives for it bit for bit; the default tests the lanes
+    /// one by one, a test may do them at once.
+    #[inline(always)]
+    fn intersect_block(
+        ray: &Self::PerRay,
+        block: &TriangleBlock,
+        tmin: f32,
+        tmax: f32,
+    ) -> [Option<TriangleHit>; BLOCK] {
+        core::array::from_fn(|lane| {
+            let [a, b, c] = block.lane(lane);
+            Self::intersect_in_place(ray, [&a, &b, &c], tmin, tmax)
+        })
     }
 }

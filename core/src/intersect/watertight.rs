@@ -1,4 +1,4 @@
-use super::{TriangleHit, TriangleTest};
+use super::{TriangleBlock, TriangleHit, TriangleTest, BLOCK};
 use crate::Ray;
 use glam::{Vec3, Vec3A};
 
@@ -98,11 +98,114 @@ impl TriangleTest for Watertight {
         }
         Some(TriangleHit { t, u: v / det, v: w / det })
     }
+
+    /// Four triangles at once (SSE on x86_64), each lane the scalar test's operations in its
+    /// order, so every answer is [`Watertight::intersect_in_place`]'s bit for bit; a lane with a
+    /// zero edge function takes the scalar test and its `f64` fallback.
+    #[inline(always)]
+    fn intersect_block(r: &ShearedRay, block: &TriangleBlock, tmin: f32, tmax: f32) -> [Option<TriangleHit>; BLOCK] {
+        #[cfg(target_arch = "x86_64")]
+        return sse::intersect_block(r, block, tmin, tmax);
+        #[cfg(not(target_arch = "x86_64"))]
+        return core::array::from_fn(|lane| {
+            let [a, b, c] = block.lane(lane);
+            Self::intersect_in_place(r, [&a, &b, &c], tmin, tmax)
+        });
+    }
+}
+
+/// The SSE path of [`Watertight::intersect_block`] (SSE2 is part of the x86_64 baseline).
+#[cfg(target_arch = "x86_64")]
+mod sse {
+    use super::{ShearedRay, TriangleBlock, TriangleHit, TriangleTest, Watertight, BLOCK};
+    use core::arch::x86_64::{
+        __m128, _mm_add_ps, _mm_and_ps, _mm_andnot_ps, _mm_cmpeq_ps, _mm_cmpgt_ps, _mm_cmplt_ps, _mm_cmpngt_ps,
+        _mm_cmpnlt_ps, _mm_div_ps, _mm_loadu_ps, _mm_movemask_ps, _mm_mul_ps, _mm_or_ps, _mm_set1_ps, _mm_storeu_ps,
+        _mm_sub_ps,
+    };
+
+    #[inline(always)]
+    #[allow(unused_unsafe)] // SSE2 intrinsics are safe to call from Rust 1.87 on; rust-version is older.
+    pub(super) fn intersect_block(
+        r: &ShearedRay,
+        block: &TriangleBlock,
+        tmin: f32,
+        tmax: f32,
+    ) -> [Option<TriangleHit>; BLOCK] {
+        let [kx, ky, kz] = r.k;
+        let [ox, oy, oz] = r.origin;
+        let [sx, sy, sz] = r.s;
+        // SAFETY: SSE2 is part of the x86_64 baseline; loads and stores are of four-float arrays.
+        let (ok, t, u, v, zero) = unsafe {
+            let splat = _mm_set1_ps;
+            let load = |a: &[f32; 4]| _mm_loadu_ps(a.as_ptr());
+            let rel = |vertex: usize| {
+                let p = &block.v[vertex];
+                (
+                    _mm_sub_ps(load(&p[kx]), splat(ox)),
+                    _mm_sub_ps(load(&p[ky]), splat(oy)),
+                    _mm_sub_ps(load(&p[kz]), splat(oz)),
+                )
+            };
+            let ((a0, a1, a2), (b0, b1, b2), (c0, c1, c2)) = (rel(0), rel(1), rel(2));
+            let (sxv, syv, szv) = (splat(sx), splat(sy), splat(sz));
+            let ax = _mm_sub_ps(a0, _mm_mul_ps(sxv, a2));
+            let ay = _mm_sub_ps(a1, _mm_mul_ps(syv, a2));
+            let bx = _mm_sub_ps(b0, _mm_mul_ps(sxv, b2));
+            let by = _mm_sub_ps(b1, _mm_mul_ps(syv, b2));
+            let cx = _mm_sub_ps(c0, _mm_mul_ps(sxv, c2));
+            let cy = _mm_sub_ps(c1, _mm_mul_ps(syv, c2));
+            let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+            let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+            let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+            let z = splat(0.0);
+            let zero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, z), _mm_cmpeq_ps(v, z)), _mm_cmpeq_ps(w, z));
+            let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, z), _mm_cmplt_ps(v, z)), _mm_cmplt_ps(w, z));
+            let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, z), _mm_cmpgt_ps(v, z)), _mm_cmpgt_ps(w, z));
+            let det = _mm_add_ps(_mm_add_ps(u, v), w);
+            let az = _mm_mul_ps(szv, a2);
+            let bz = _mm_mul_ps(szv, b2);
+            let cz = _mm_mul_ps(szv, c2);
+            let t = _mm_div_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)), _mm_mul_ps(w, cz)), det);
+            // `!t.is_finite() || t < tmin || t > tmax` rejects: NaN fails `|t| < inf`.
+            let abs_t = _mm_andnot_ps(splat(-0.0), t);
+            let finite = _mm_cmplt_ps(abs_t, splat(f32::INFINITY));
+            let in_range = _mm_and_ps(_mm_cmpnlt_ps(t, splat(tmin)), _mm_cmpngt_ps(t, splat(tmax)));
+            let det_ok = _mm_andnot_ps(_mm_cmpeq_ps(det, z), _mm_cmpeq_ps(z, z));
+            let ok = _mm_and_ps(_mm_andnot_ps(_mm_and_ps(neg, pos), det_ok), _mm_and_ps(finite, in_range));
+            let store = |x: __m128| {
+                let mut out = [0.0f32; 4];
+                _mm_storeu_ps(out.as_mut_ptr(), x);
+                out
+            };
+            (
+                _mm_movemask_ps(ok) as u32,
+                store(t),
+                store(_mm_div_ps(v, det)),
+                store(_mm_div_ps(w, det)),
+                _mm_movemask_ps(zero) as u32,
+            )
+        };
+        core::array::from_fn(|lane| {
+            if zero & (1 << lane) != 0 {
+                // A zero edge function: the scalar test, with its f64 recomputation.
+                let [a, b, c] = block.lane(lane);
+                Watertight::intersect_in_place(r, [&a, &b, &c], tmin, tmax)
+            } else if ok & (1 << lane) != 0 {
+                Some(TriangleHit { t: t[lane], u: u[lane], v: v[lane] })
+            } else {
+                None
+            }
+        })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Triangle;
+    use crate::intersect::test_values::Rng;
+    use alloc::vec::Vec;
 
     fn shoot(o: Vec3, d: Vec3, tri: [Vec3; 3]) -> Option<TriangleHit> {
         let r = Watertight::prepare(&Ray::new(o, d, 0.0, f32::INFINITY));
@@ -208,5 +311,45 @@ mod tests {
             hits += fast.is_some() as u32;
         }
         assert!(hits > 1000 && per_k.iter().all(|&n| n > 1000), "{hits} hits, permutations {per_k:?}");
+    }
+
+    #[test]
+    fn four_at_once_equals_one_at_a_time_bit_for_bit() {
+        let mut rng = Rng(0x5851_f42d_4c95_7f2d);
+        let same = |a: Option<TriangleHit>, b: Option<TriangleHit>| match (a, b) {
+            (None, None) => true,
+            (Some(a), Some(b)) => [a.t, a.u, a.v].map(f32::to_bits) == [b.t, b.u, b.v].map(f32::to_bits),
+            _ => false,
+        };
+        let (mut hits, mut fallbacks) = (0, 0);
+        for i in 0..100_000 {
+            let (ray, _) = rng.ray_and_slab();
+            if !ray.is_traceable() {
+                continue;
+            }
+            let r = Watertight::prepare(&ray);
+            // Shared vertices and edges among the lanes, as in a mesh, so zero edge functions come up.
+            let pool: [Vec3; 4] = core::array::from_fn(|_| {
+                let mut v = || rng.adversarial();
+                Vec3::new(v(), v(), v())
+            });
+            let tris: Vec<Triangle> = (0..1 + i % 4)
+                .map(|k| Triangle::new(pool[k % 4], pool[(k + 1) % 4], pool[(k + 2 + (i / 4) % 2) % 4]))
+                .collect();
+            let block = TriangleBlock::new(&tris);
+            let got = Watertight::intersect_block(&r, &block, ray.tmin, ray.tmax);
+            for (lane, g) in got.iter().enumerate() {
+                let [a, b, c] = block.lane(lane);
+                let want = Watertight::intersect_in_place(&r, [&a, &b, &c], ray.tmin, ray.tmax);
+                assert!(same(*g, want), "lane {lane} of {tris:?}, {ray:?}: {g:?} != {want:?}");
+                hits += usize::from(want.is_some());
+                if lane < tris.len() {
+                    let (ax, ay) = (a[r.k[0]] - r.origin[0], a[r.k[1]] - r.origin[1]);
+                    fallbacks += usize::from(ax == 0.0 || ay == 0.0);
+                }
+            }
+        }
+        assert!(hits > 1_000, "only {hits} hits");
+        assert!(fallbacks > 100, "only {fallbacks} lanes near the fallback");
     }
 }

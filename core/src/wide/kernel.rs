@@ -14,8 +14,16 @@ pub struct ChildHits<const W: usize> {
     pub mask: u32,
 }
 
-/// Tests a node's child boxes and orders the hit children.
+/// Tests a node's child boxes and orders the hit children, and says how leaves are tested.
 pub trait ChildKernel {
+    /// Whether leaves are tested four triangles at once ([`TriangleTest::intersect_block`]) or
+    /// one at a time; the answers are the same.
+    ///
+    /// [`TriangleTest::intersect_block`]: crate::intersect::TriangleTest::intersect_block
+    const BLOCKS: bool;
+    /// Whether any-hit queries also visit hit children nearest first. Guthe (Sec. 4.2) pushes
+    /// them unsorted, the default; the sorted form is there to measure that choice against.
+    const SORTED_ANY: bool = false;
     /// The slab test ([`SlabRay::hit`]) of every child box over `[tmin, tmax]`.
     fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W>;
     /// Writes the hit slots to `order` nearest first (ties to the smaller slot) and returns how
@@ -29,6 +37,8 @@ pub trait ChildKernel {
 pub struct ReferenceKernel;
 
 impl ChildKernel for ReferenceKernel {
+    const BLOCKS: bool = false;
+
     #[inline(always)]
     fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
         let mut out = ChildHits { t_enter: [f32::INFINITY; W], mask: 0 };
@@ -57,6 +67,8 @@ impl ChildKernel for ReferenceKernel {
 pub struct FastKernel;
 
 impl ChildKernel for FastKernel {
+    const BLOCKS: bool = true;
+
     #[inline(always)]
     fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
         #[cfg(target_arch = "x86_64")]

@@ -1,6 +1,7 @@
 use super::node::WideNode;
 use crate::bvh2::MemRead;
 use crate::geometry::Triangle;
+use crate::intersect::TriangleBlock;
 use glam::Vec3;
 
 /// Every memory read a wide-BVH traversal makes goes through this trait (see
@@ -12,6 +13,8 @@ pub trait WideMemory<const W: usize> {
     fn prim(&self, pos: u32) -> u32;
     /// The vertices of the triangle at position `pos`.
     fn wide_triangle(&self, pos: u32) -> MemRead<'_, [Vec3; 3]>;
+    /// The block of four triangles `index` (positions `4 index ..`).
+    fn wide_block(&self, index: u32) -> MemRead<'_, TriangleBlock>;
 }
 
 /// A wide tree in plain slices: the CPU backend's memory.
@@ -21,6 +24,8 @@ pub struct WideSliceMemory<'a, const W: usize> {
     pub nodes: &'a [WideNode<W>],
     /// Triangles in leaf order.
     pub triangles: &'a [Triangle],
+    /// The same triangles in blocks of four.
+    pub blocks: &'a [TriangleBlock],
     /// Primitive id per triangle position.
     pub prims: &'a [u32],
 }
@@ -37,5 +42,9 @@ impl<const W: usize> WideMemory<W> for WideSliceMemory<'_, W> {
     #[inline(always)]
     fn wide_triangle(&self, pos: u32) -> MemRead<'_, [Vec3; 3]> {
         MemRead::InPlace(&self.triangles[pos as usize].v)
+    }
+    #[inline(always)]
+    fn wide_block(&self, index: u32) -> MemRead<'_, TriangleBlock> {
+        MemRead::InPlace(&self.blocks[index as usize])
     }
 }

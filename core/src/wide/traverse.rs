@@ -5,7 +5,7 @@
 use super::kernel::ChildKernel;
 use super::memory::WideMemory;
 use super::node::WideChild;
-use crate::intersect::{NoPair, RayContext, TriangleTest};
+use crate::intersect::{NoPair, RayContext, TriangleTest, BLOCK};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
 use crate::traverse::{begin, QueryState, Step};
@@ -71,7 +71,7 @@ impl<const W: usize> WideState<W> {
                     return self.pop(ctx, q, obs, false);
                 }
                 let mut order = [0u32; W];
-                let n = if q.any {
+                let n = if q.any && !K::SORTED_ANY {
                     // Unsorted: slot order.
                     let mut m = hits.mask;
                     let mut n = 0;
@@ -98,7 +98,11 @@ impl<const W: usize> WideState<W> {
                 Step::Continue
             }
             WideChild::Leaf { first, count } => {
-                let hit = leaf(mem, first, count, ctx, q, obs);
+                let hit = if K::BLOCKS {
+                    leaf_blocks(mem, first, count, ctx, q, obs)
+                } else {
+                    leaf(mem, first, count, ctx, q, obs)
+                };
                 if q.is_answered() {
                     return Step::Done;
                 }
@@ -160,6 +164,44 @@ fn leaf<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>
                     return true;
                 }
             }
+        }
+    }
+    taken
+}
+
+/// [`leaf`] four triangles at a time, all four against the limit the block starts with, then
+/// offered in order: a triangle a hit earlier in the block would have culled is refused by the
+/// offer instead (it is farther, or tied with a larger id), so the answer and the events are
+/// [`leaf`]'s.
+#[inline(always)]
+fn leaf_blocks<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
+    mem: &M,
+    first: u32,
+    count: u32,
+    ctx: &WideRayContext<T>,
+    q: &mut QueryState,
+    obs: &mut O,
+) -> bool {
+    let per_ray = ctx.tri();
+    let mut taken = false;
+    let end = first + count;
+    let mut pos = first;
+    while pos < end {
+        let block = mem.wide_block(pos / BLOCK as u32);
+        let hits = T::intersect_block(&per_ray, &block, ctx.ray.tmin, q.limit());
+        for h in hits.iter().take((end - pos).min(BLOCK as u32) as usize) {
+            let prim = mem.prim(pos);
+            obs.primitive(prim);
+            if let Some(h) = *h {
+                if q.offer(h, prim) {
+                    obs.hit(prim, h.t);
+                    taken = true;
+                    if q.any {
+                        return true;
+                    }
+                }
+            }
+            pos += 1;
         }
     }
     taken

@@ -1,6 +1,7 @@
 use super::node::{WideChild, WideNode};
 use crate::bvh2::{Bvh2, NodeKind, NodeRef};
 use crate::geometry::Triangle;
+use crate::intersect::{TriangleBlock, BLOCK};
 use crate::method::Collapse;
 use crate::Error;
 use alloc::vec::Vec;
@@ -23,11 +24,16 @@ pub struct WideStats {
 /// A `W`-wide BVH collapsed from a canonical BVH2 (Guthe 2014, Sec. 4.1), with its triangles in
 /// leaf order. Every wide node stands for the binary node it was collapsed from, and every leaf is
 /// a binary leaf with the same triangles, so enumerations name canonical BVH2 nodes.
+///
+/// Each leaf starts at a multiple of [`BLOCK`] in the triangle array (the gaps hold NaN triangles
+/// that nothing hits, with primitive id `u32::MAX`), so its triangles are also whole
+/// [`TriangleBlock`]s, `first / BLOCK` onwards, for testing four at once.
 #[derive(Clone, Debug)]
 pub struct WideBvh<const W: usize> {
     nodes: Vec<WideNode<W>>,
     root: WideChild,
     triangles: Vec<Triangle>,
+    blocks: Vec<TriangleBlock>,
     prims: Vec<u32>,
     node_ids: Vec<u32>,
     leaf_ids: Vec<u32>,
@@ -41,29 +47,27 @@ impl<const W: usize> WideBvh<W> {
         if !(2..=32).contains(&W) {
             return Err(Error::MalformedTree("a wide BVH has 2 to 32 children per node"));
         }
-        let order = bvh.prim_order();
-        let tris = order
-            .iter()
-            .map(|&p| triangles.get(p as usize).copied().ok_or(Error::MalformedTree("primitive id out of range")))
-            .collect::<Result<Vec<Triangle>, Error>>()?;
         let leaves_below = leaves_below(bvh);
         let mut b = Builder {
             bvh,
+            scene: triangles,
             collapse,
             leaves_below,
             out: WideBvh {
                 nodes: Vec::new(),
                 root: WideChild::Node(0),
-                triangles: tris,
-                prims: order.to_vec(),
+                triangles: Vec::with_capacity(bvh.prim_order().len() * 5 / 4),
+                blocks: Vec::new(),
+                prims: Vec::with_capacity(bvh.prim_order().len() * 5 / 4),
                 node_ids: Vec::new(),
-                leaf_ids: alloc::vec![u32::MAX; order.len()],
+                leaf_ids: Vec::new(),
                 stats: WideStats { nodes: 0, leaves: 0, depth: 0, empty_slots: 0, node_bytes: 0 },
             },
         };
         let root = b.child(0, 0)?;
         let mut out = b.out;
         out.root = root;
+        out.blocks = out.triangles.chunks(BLOCK).map(TriangleBlock::new).collect();
         out.stats.nodes = out.nodes.len();
         out.stats.node_bytes = out.nodes.len() * core::mem::size_of::<WideNode<W>>();
         Ok(out)
@@ -84,7 +88,22 @@ impl<const W: usize> WideBvh<W> {
         &self.triangles
     }
 
-    /// The primitive id of each triangle position.
+    /// The triangles in blocks of four: block `i` holds positions `4 i .. 4 i + 3`.
+    pub fn blocks(&self) -> &[TriangleBlock] {
+        &self.blocks
+    }
+
+    /// The tree as [`WideMemory`](super::WideMemory) for traversal in place.
+    pub fn memory(&self) -> super::WideSliceMemory<'_, W> {
+        super::WideSliceMemory {
+            nodes: &self.nodes,
+            triangles: &self.triangles,
+            blocks: &self.blocks,
+            prims: &self.prims,
+        }
+    }
+
+    /// The primitive id of each triangle position (`u32::MAX` in the gaps between leaves).
     pub fn prims(&self) -> &[u32] {
         &self.prims
     }
@@ -122,6 +141,7 @@ fn leaves_below(bvh: &Bvh2) -> Vec<u32> {
 
 struct Builder<'a, const W: usize> {
     bvh: &'a Bvh2,
+    scene: &'a [Triangle],
     collapse: Collapse,
     leaves_below: Vec<u32>,
     out: WideBvh<W>,
@@ -133,10 +153,24 @@ impl<const W: usize> Builder<'_, W> {
         let node = self.bvh.nodes()[n as usize];
         match node.kind {
             NodeKind::Leaf { first, count } => {
-                self.out.leaf_ids[first as usize] = n;
+                let at = self.out.triangles.len();
+                let start =
+                    u32::try_from(at).map_err(|_| Error::TreeTooLarge { what: "triangle positions", size: at })?;
+                for &p in &self.bvh.prim_order()[first as usize..(first + count) as usize] {
+                    let tri = self.scene.get(p as usize).ok_or(Error::MalformedTree("primitive id out of range"))?;
+                    self.out.triangles.push(*tri);
+                    self.out.prims.push(p);
+                }
+                // The next leaf starts on a block boundary.
+                let gap = self.out.triangles.len().next_multiple_of(BLOCK) - self.out.triangles.len();
+                let nan = Triangle { v: [glam::Vec3::NAN; 3] };
+                self.out.triangles.extend(core::iter::repeat_n(nan, gap));
+                self.out.prims.extend(core::iter::repeat_n(u32::MAX, gap));
+                self.out.leaf_ids.resize(self.out.triangles.len(), u32::MAX);
+                self.out.leaf_ids[at] = n;
                 self.out.stats.leaves += 1;
                 self.out.stats.depth = self.out.stats.depth.max(depth);
-                Ok(WideChild::Leaf { first, count })
+                Ok(WideChild::Leaf { first: start, count })
             }
             NodeKind::Internal { .. } => {
                 let index = u32::try_from(self.out.nodes.len())

@@ -1,0 +1,40 @@
+use crate::geometry::Triangle;
+use bytemuck::{Pod, Zeroable};
+
+/// Triangles per [`TriangleBlock`].
+pub const BLOCK: usize = 4;
+
+/// Four triangles as a structure of arrays, for testing them at once: `v[vertex][axis][lane]`.
+/// Lanes without a triangle hold NaN vertices, which no test hits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct TriangleBlock {
+    /// Vertex coordinates by vertex, axis and lane.
+    pub v: [[[f32; BLOCK]; 3]; 3],
+}
+
+// SAFETY: `repr(C)` arrays of `f32`: no padding, every bit pattern valid.
+unsafe impl Zeroable for TriangleBlock {}
+// SAFETY: as above.
+unsafe impl Pod for TriangleBlock {}
+
+impl TriangleBlock {
+    /// A block of up to four triangles (the rest of the lanes empty).
+    pub fn new(triangles: &[Triangle]) -> TriangleBlock {
+        let mut b = TriangleBlock { v: [[[f32::NAN; BLOCK]; 3]; 3] };
+        for (lane, t) in triangles.iter().take(BLOCK).enumerate() {
+            for (vertex, p) in t.v.iter().enumerate() {
+                for axis in 0..3 {
+                    b.v[vertex][axis][lane] = p[axis];
+                }
+            }
+        }
+        b
+    }
+
+    /// The vertices of `lane`, as a single-triangle test reads them.
+    #[inline(always)]
+    pub fn lane(&self, lane: usize) -> [[f32; 3]; 3] {
+        core::array::from_fn(|vertex| core::array::from_fn(|axis| self.v[vertex][axis][lane]))
+    }
+}
