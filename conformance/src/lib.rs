@@ -10,7 +10,7 @@
 //! raytrail_conformance::conformance_suite!(raytrail_cpu::CpuBackend::new());
 //! ```
 //!
-//! [`Method::reference`]: raytrail_core::traverse::Method::reference
+//! [`Method::reference`]: raytrail_core::method::Method::reference
 #![warn(missing_docs)]
 
 pub mod check;

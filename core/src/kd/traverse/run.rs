@@ -18,7 +18,7 @@ pub struct KdRoot {
     /// Largest coordinate magnitude in the scene (for [`RayContext::new`](crate::intersect::RayContext::new)).
     pub scene_scale: f32,
     /// Steps after which traversal stops (it never binds on an intact tree; see
-    /// [`TraceRoot`](crate::traverse::TraceRoot)).
+    /// [`TraceRoot`](crate::bvh2::traverse::TraceRoot)).
     pub max_steps: u32,
     /// Entries of the short stack (Horn et al. use 3).
     pub short_stack: usize,
