@@ -57,7 +57,7 @@ forward!(impl<K: Key> for RegisterState<K, PerfectHashLookup, true>);
 
 /// Method (f) as a lane: method (d) that, after each leaf accepting a hit, saves only key and
 /// trail ([`Paused`]) and resumes through the hash over every node, within the same step (as
-/// [`trace_pausing`](raytrail_core::traverse::trace_pausing) does). The resume's lookup is read
+/// [`trace_pausing`](raytrail_core::bvh2::traverse::trace_pausing) does). The resume's lookup is read
 /// through the lane's memory, so it is counted as hash traffic.
 #[derive(Clone, Copy, Debug)]
 pub struct Resuming<K: Key>(RegisterState<K, PerfectHashLookup, false>);
