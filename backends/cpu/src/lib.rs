@@ -8,6 +8,8 @@
 //! The crate also holds the obvhs (PLOC) BVH2 builder ([`ploc`]).
 #![warn(missing_docs)]
 
+#[cfg(target_arch = "x86_64")]
+mod avx;
 mod backend;
 mod bvh2;
 mod chunk;

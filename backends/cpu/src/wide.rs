@@ -1,15 +1,17 @@
 //! The wide-BVH methods' loop for one chunk, monomorphized per width x triangle test x recording,
-//! with the fast child kernel (SIMD box tests, the sorting network).
+//! with the fast child kernel (SIMD box tests, the sorting network), in the AVX2 loop where the
+//! processor has AVX2.
 
 use crate::chunk::Chunk;
 use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
+use raytrail_core::method::Query;
 use raytrail_core::method::{Method, WideMethod};
-use raytrail_core::observe::{Both, Counters, NoObserver, Recorder};
+use raytrail_core::observe::{Both, Counters, NoObserver, Observer, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
-use raytrail_core::wide::traverse::{trace_wide_batch, trace_wide_ray, WideRoot};
+use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{FastKernel, WideSliceMemory};
-use raytrail_core::Error;
+use raytrail_core::{Error, Hit, Ray};
 
 /// Traces one chunk with `method`; returns its counters.
 pub(crate) fn trace_chunk(
@@ -50,17 +52,13 @@ fn run<const W: usize, T: TriangleTest>(
     let query = opts.query;
     let mut counters = Counters::default();
     match opts.record {
-        Record::Nothing => {
-            trace_wide_batch::<W, _, T, FastKernel, _>(mem, root, chunk.rays, chunk.hits, query, &mut NoObserver)
-        }
-        Record::Counters => {
-            trace_wide_batch::<W, _, T, FastKernel, _>(mem, root, chunk.rays, chunk.hits, query, &mut counters)
-        }
+        Record::Nothing => batch::<W, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut NoObserver),
+        Record::Counters => batch::<W, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut counters),
         Record::Enumerations => {
             let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());
             for ((ray, hit), nodes) in slots {
                 let mut obs = Both(counters, Recorder::default());
-                *hit = trace_wide_ray::<W, _, T, FastKernel, _>(mem, root, ray, query, &mut obs);
+                batch::<W, T, _>(mem, root, core::slice::from_ref(ray), core::slice::from_mut(hit), query, &mut obs);
                 counters = obs.0;
                 *nodes = scene.canonical_ids(Method::Wide(method), obs.1.nodes.iter().copied())?;
             }
@@ -68,4 +66,25 @@ fn run<const W: usize, T: TriangleTest>(
     }
     counters.rays = chunk.rays.len() as u64;
     Ok(counters)
+}
+
+/// The batch loop: the AVX2 one where the processor has AVX2, else the baseline fast kernel (SSE
+/// on x86_64). Every recording mode goes through here, so the conformance suite checks the path
+/// the timings take.
+#[inline(always)]
+fn batch<const W: usize, T: TriangleTest, O: Observer>(
+    mem: &WideSliceMemory<'_, W>,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    obs: &mut O,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::avx::available() {
+        // SAFETY: the processor has AVX2 (checked just above).
+        unsafe { crate::avx::trace_batch::<W, _, T, O>(mem, root, rays, hits, query, obs) };
+        return;
+    }
+    trace_wide_batch::<W, _, T, FastKernel, O>(mem, root, rays, hits, query, obs);
 }

@@ -1,0 +1,160 @@
+//! The AVX2 path of the wide traversal, chosen at run time: an 8-wide node's boxes in one 256-bit
+//! operation per step, and the whole batch loop compiled for AVX2 (so the 4-wide SSE code and the
+//! triangle tests get its three-operand encoding too). Every answer is the reference kernel's bit
+//! for bit; the test below holds it to that on adversarial values.
+
+use raytrail_core::intersect::{SlabRay, TriangleTest, FAR_PAD};
+use raytrail_core::method::Query;
+use raytrail_core::observe::Observer;
+use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
+use raytrail_core::wide::{ChildHits, ChildKernel, FastKernel, WideMemory, WideNode};
+use raytrail_core::{Hit, Ray};
+use std::arch::x86_64::{
+    __m256, _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_max_ps,
+    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
+    _CMP_LE_OQ,
+};
+
+/// Whether this processor runs the AVX2 path.
+pub(crate) fn available() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+}
+
+/// The fast kernel with 8-wide nodes tested in one AVX operation per plane. Private to this
+/// module and used only inside [`trace_batch`], whose caller has checked for AVX2: that is what
+/// makes its unchecked AVX calls sound (a check per node cost 2% of a ray's time).
+struct AvxKernel;
+
+impl ChildKernel for AvxKernel {
+    const BLOCKS: bool = true;
+
+    #[inline(always)]
+    fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
+        if W % 8 == 0 {
+            // SAFETY: only `trace_batch` uses this kernel, and only on a processor with AVX2.
+            unsafe { test_avx(node, slab, tmin, tmax) }
+        } else {
+            FastKernel::test(node, slab, tmin, tmax)
+        }
+    }
+
+    #[inline(always)]
+    fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
+        FastKernel::order(hits, order)
+    }
+}
+
+/// Eight children per operation, with [`SlabRay::hit_scalar`]'s operations in its order per lane
+/// (`vmaxps(x, acc)` is `keep_max(acc, x)`, likewise `vminps`).
+///
+/// # Safety
+/// The processor must support AVX.
+#[target_feature(enable = "avx")]
+#[inline]
+unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
+    let mut out = ChildHits { t_enter: [f32::INFINITY; W], mask: 0 };
+    let (o, inv) = (s.origin.to_array(), s.inv_dir.to_array());
+    let mut lane = 0;
+    while lane + 8 <= W {
+        let splat = |x: f32| _mm256_set1_ps(x);
+        let (mut t_enter, mut t_exit) = (splat(tmin), splat(tmax));
+        for a in 0..3 {
+            // SAFETY: eight floats inside arrays of `W`, from `lane <= W - 8`.
+            let (lo, hi) = unsafe {
+                (_mm256_loadu_ps(node.lo[a].as_ptr().add(lane)), _mm256_loadu_ps(node.hi[a].as_ptr().add(lane)))
+            };
+            let (near, far): (__m256, __m256) = if s.negative[a] { (hi, lo) } else { (lo, hi) };
+            let (oa, ia) = (splat(o[a]), splat(inv[a]));
+            let tn = _mm256_mul_ps(_mm256_sub_ps(near, oa), ia);
+            let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, oa), ia), splat(FAR_PAD));
+            t_enter = _mm256_max_ps(tn, t_enter);
+            t_exit = _mm256_min_ps(tf, t_exit);
+        }
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, _mm256_add_ps(t_exit, splat(s.slack)));
+        let kept = _mm256_or_ps(_mm256_and_ps(hit, t_enter), _mm256_andnot_ps(hit, splat(f32::INFINITY)));
+        // SAFETY: as the loads.
+        unsafe { _mm256_storeu_ps(out.t_enter.as_mut_ptr().add(lane), kept) };
+        out.mask |= (_mm256_movemask_ps(hit) as u32) << lane;
+        lane += 8;
+    }
+    out
+}
+
+/// [`trace_wide_batch`] with [`AvxKernel`], compiled for AVX2.
+///
+/// # Safety
+/// The processor must support AVX2 ([`available`]).
+#[target_feature(enable = "avx2")]
+pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    obs: &mut O,
+) {
+    trace_wide_batch::<W, M, T, AvxKernel, O>(mem, root, rays, hits, query, obs);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use raytrail_core::wide::{ReferenceKernel, WideChild};
+
+    /// Ordinary values with zeros of both signs, infinities, NaN, a subnormal and exact repeats.
+    struct Values(u64);
+
+    impl Values {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            match self.0 % 16 {
+                0 => 0.0,
+                1 => -0.0,
+                2 => [0.5, -0.25, 1.0, 3.0][(self.0 >> 8) as usize % 4],
+                3 => [f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 1e-40][(self.0 >> 8) as usize % 4],
+                _ => ((self.0 >> 8) % 2001) as f32 / 256.0 - 1000.0 / 256.0,
+            }
+        }
+    }
+
+    #[test]
+    fn avx_kernel_matches_the_reference_bit_for_bit_on_adversarial_values() {
+        if !available() {
+            eprintln!("SKIPPED the AVX2 kernel test: this processor has no AVX2");
+            return;
+        }
+        let mut v = Values(0x9e37_79b9_7f4a_7c15);
+        let mut hits = 0;
+        for _ in 0..100_000 {
+            let ray = Ray {
+                origin: [v.next(), v.next(), v.next()],
+                tmin: v.next(),
+                dir: [v.next(), v.next(), v.next()],
+                tmax: v.next(),
+            };
+            let slab = SlabRay { slack: [0.0, 1e-5, f32::INFINITY][(v.0 % 3) as usize], ..SlabRay::new(&ray) };
+            let mut node = WideNode::<8>::EMPTY;
+            for i in 0..8 {
+                if v.next() < 0.0 {
+                    continue;
+                }
+                let (lo, hi) = (Vec3::new(v.next(), v.next(), v.next()), Vec3::new(v.next(), v.next(), v.next()));
+                node.set_child(i, lo, hi, WideChild::Node(i as u32));
+            }
+            let (a, r) = (
+                AvxKernel::test(&node, &slab, ray.tmin, ray.tmax),
+                ReferenceKernel::test(&node, &slab, ray.tmin, ray.tmax),
+            );
+            assert_eq!(
+                (a.mask, a.t_enter.map(f32::to_bits)),
+                (r.mask, r.t_enter.map(f32::to_bits)),
+                "{ray:?} {node:?}"
+            );
+            hits += r.mask.count_ones();
+        }
+        assert!(hits > 20_000, "only {hits} child hits");
+    }
+}
