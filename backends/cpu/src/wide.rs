@@ -22,50 +22,47 @@ pub(crate) fn trace_chunk(
 ) -> Result<Counters, Error> {
     let root = scene.wide_root(method)?;
     match method.width() {
-        4 => go(scene, method, opts, &scene.wide4(method)?.memory(), root, chunk),
-        _ => go(scene, method, opts, &scene.wide8(method)?.memory(), root, chunk),
+        4 => WideRun { scene, method, opts, mem: scene.wide4(method)?.memory(), root }.go(chunk),
+        _ => WideRun { scene, method, opts, mem: scene.wide8(method)?.memory(), root }.go(chunk),
     }
 }
 
-fn go<const W: usize>(
-    scene: &PreparedScene,
+struct WideRun<'a, const W: usize> {
+    scene: &'a PreparedScene,
     method: WideMethod,
-    opts: &TraceOptions,
-    mem: &WideSliceMemory<'_, W>,
+    opts: &'a TraceOptions,
+    mem: WideSliceMemory<'a, W>,
     root: WideRoot,
-    chunk: Chunk<'_>,
-) -> Result<Counters, Error> {
-    match opts.triangle_test {
-        TriangleTestKind::Watertight => run::<W, Watertight>(scene, method, opts, mem, root, chunk),
-        TriangleTestKind::MollerTrumbore => run::<W, MollerTrumbore>(scene, method, opts, mem, root, chunk),
-    }
 }
 
-fn run<const W: usize, T: TriangleTest>(
-    scene: &PreparedScene,
-    method: WideMethod,
-    opts: &TraceOptions,
-    mem: &WideSliceMemory<'_, W>,
-    root: WideRoot,
-    chunk: Chunk<'_>,
-) -> Result<Counters, Error> {
-    let query = opts.query;
-    let mut counters = Counters::default();
-    match opts.record {
-        Record::Nothing => batch::<W, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut NoObserver),
-        Record::Counters => batch::<W, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut counters),
-        Record::Enumerations => {
-            let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());
-            for ((ray, hit), nodes) in slots {
-                let mut obs = Both(counters, Recorder::default());
-                batch::<W, T, _>(mem, root, core::slice::from_ref(ray), core::slice::from_mut(hit), query, &mut obs);
-                counters = obs.0;
-                *nodes = scene.canonical_ids(Method::Wide(method), obs.1.nodes.iter().copied())?;
-            }
+impl<const W: usize> WideRun<'_, W> {
+    fn go(&self, chunk: Chunk<'_>) -> Result<Counters, Error> {
+        match self.opts.triangle_test {
+            TriangleTestKind::Watertight => self.run::<Watertight>(chunk),
+            TriangleTestKind::MollerTrumbore => self.run::<MollerTrumbore>(chunk),
         }
     }
-    counters.rays = chunk.rays.len() as u64;
-    Ok(counters)
+
+    fn run<T: TriangleTest>(&self, chunk: Chunk<'_>) -> Result<Counters, Error> {
+        let (mem, root, query) = (&self.mem, self.root, self.opts.query);
+        let mut counters = Counters::default();
+        match self.opts.record {
+            Record::Nothing => batch::<W, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut NoObserver),
+            Record::Counters => batch::<W, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut counters),
+            Record::Enumerations => {
+                let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());
+                for ((ray, hit), nodes) in slots {
+                    let mut obs = Both(counters, Recorder::default());
+                    let (ray, hit) = (core::slice::from_ref(ray), core::slice::from_mut(hit));
+                    batch::<W, T, _>(mem, root, ray, hit, query, &mut obs);
+                    counters = obs.0;
+                    *nodes = self.scene.canonical_ids(Method::Wide(self.method), obs.1.nodes.iter().copied())?;
+                }
+            }
+        }
+        counters.rays = chunk.rays.len() as u64;
+        Ok(counters)
+    }
 }
 
 /// The batch loop: the AVX2 one where the processor has AVX2, else the baseline fast kernel (SSE

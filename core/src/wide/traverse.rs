@@ -98,11 +98,7 @@ impl<const W: usize> WideState<W> {
                 Step::Continue
             }
             WideChild::Leaf { first, count } => {
-                let hit = if K::BLOCKS {
-                    leaf_blocks(mem, first, count, ctx, q, obs)
-                } else {
-                    leaf(mem, first, count, ctx, q, obs)
-                };
+                let hit = leaf::<W, M, T, K, O>(mem, first, count, ctx, q, obs);
                 if q.is_answered() {
                     return Step::Done;
                 }
@@ -139,42 +135,13 @@ impl<const W: usize> WideState<W> {
 
 /// Tests the ray against the `count` triangles from position `first`; returns whether a hit was
 /// taken. An any-hit query stops at its first hit.
+///
+/// With [`ChildKernel::BLOCKS`], four triangles at a time, all four against the limit the block
+/// starts with, then offered in order: a triangle that a hit earlier in the block would have
+/// culled is refused by the offer instead (it is farther, or tied with a larger id), so the answer
+/// and the events are those of one triangle at a time.
 #[inline(always)]
-fn leaf<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
-    mem: &M,
-    first: u32,
-    count: u32,
-    ctx: &WideRayContext<T>,
-    q: &mut QueryState,
-    obs: &mut O,
-) -> bool {
-    let per_ray = ctx.tri();
-    let mut taken = false;
-    for pos in first..first + count {
-        let prim = mem.prim(pos);
-        obs.primitive(prim);
-        let tri = mem.wide_triangle(pos);
-        let [a, b, c] = &*tri;
-        if let Some(h) = T::intersect_in_place(&per_ray, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit())
-        {
-            if q.offer(h, prim) {
-                obs.hit(prim, h.t);
-                taken = true;
-                if q.any {
-                    return true;
-                }
-            }
-        }
-    }
-    taken
-}
-
-/// [`leaf`] four triangles at a time, all four against the limit the block starts with, then
-/// offered in order: a triangle a hit earlier in the block would have culled is refused by the
-/// offer instead (it is farther, or tied with a larger id), so the answer and the events are
-/// [`leaf`]'s.
-#[inline(always)]
-fn leaf_blocks<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
+fn leaf<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
     mem: &M,
     first: u32,
     count: u32,
@@ -187,9 +154,17 @@ fn leaf_blocks<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Ob
     let end = first + count;
     let mut pos = first;
     while pos < end {
-        let block = mem.wide_block(pos / BLOCK as u32);
-        let hits = T::intersect_block(&per_ray, &block, ctx.ray.tmin, q.limit());
-        for h in hits.iter().take((end - pos).min(BLOCK as u32) as usize) {
+        let (hits, n) = if K::BLOCKS {
+            let block = mem.wide_block(pos / BLOCK as u32);
+            (T::intersect_block(&per_ray, &block, ctx.ray.tmin, q.limit()), (end - pos).min(BLOCK as u32))
+        } else {
+            let tri = mem.wide_triangle(pos);
+            let [a, b, c] = &*tri;
+            let mut hits = [None; BLOCK];
+            hits[0] = T::intersect_in_place(&per_ray, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit());
+            (hits, 1)
+        };
+        for h in &hits[..n as usize] {
             let prim = mem.prim(pos);
             obs.primitive(prim);
             if let Some(h) = *h {
