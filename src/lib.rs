@@ -44,6 +44,7 @@ pub use raytrail_wgpu as gpu;
 
 use raytrail_conformance::NamedScene;
 use raytrail_core::bvh2::{Bvh2, SahBuilder};
+use raytrail_core::mesh::{LoadOptions, LoadReport};
 use raytrail_core::scene::Scene;
 use std::path::Path;
 
@@ -87,16 +88,30 @@ impl Builder {
 /// Name of the built-in scene.
 pub const BUILTIN_SCENE: &str = "builtin";
 
-/// Loads a mesh file, or the built-in generated scene for [`BUILTIN_SCENE`].
+/// Loads a mesh file, or the built-in generated scene for [`BUILTIN_SCENE`], with the default
+/// loading policy (elements that are not triangles or polygons skipped; see
+/// [`raytrail_core::mesh`]).
 pub fn load_scene(path: &str) -> Result<NamedScene, String> {
+    load_scene_with(path, &LoadOptions::default()).map(|(scene, _)| scene)
+}
+
+/// Loads a mesh file, or the built-in generated scene for [`BUILTIN_SCENE`], with the given
+/// loading policy; also returns what loading skipped and, with [`LoadOptions::sources`], where
+/// each triangle came from (the built-in scene's report is empty).
+pub fn load_scene_with(path: &str, options: &LoadOptions) -> Result<(NamedScene, LoadReport), String> {
     if path == BUILTIN_SCENE {
         return raytrail_conformance::generated()
             .into_iter()
             .find(|s| s.name == "sphereflake")
+            .map(|s| (s, LoadReport::default()))
             .ok_or_else(|| "the built-in sphereflake scene is missing".to_string());
     }
-    let mesh = raytrail_core::mesh::load(Path::new(path)).map_err(|e| e.to_string())?;
-    let scene = mesh.to_scene().map_err(|e| format!("{path}: {e}"))?;
+    let (mesh, report) = raytrail_core::mesh::load_with(Path::new(path), options).map_err(|e| e.to_string())?;
+    let scene = mesh.to_scene().map_err(|e| match report.skipped {
+        0 => format!("{path}: {e}"),
+        1 => format!("{path}: {e} (1 element that is not a triangle or polygon was skipped)"),
+        n => format!("{path}: {e} ({n} elements that are not triangles or polygons were skipped)"),
+    })?;
     let name = Path::new(path).file_name().map_or(path.to_string(), |n| n.to_string_lossy().into_owned());
-    Ok(NamedScene::new(name, scene))
+    Ok((NamedScene::new(name, scene), report))
 }

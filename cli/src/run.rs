@@ -1,7 +1,7 @@
 //! The main job: build, prepare, trace primary, shadow and diffuse rays with every method, and
 //! report speed, work per ray, state size, hash-table figures and the conformance verdict.
 
-use crate::args::Args;
+use crate::args::{load_scene, warn, Args, STRICT};
 use crate::median::median;
 use crate::progress::{timed, Progress};
 use raytrail::conformance::check::{check_ray_set, Context, Mismatch};
@@ -13,10 +13,10 @@ use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::wide::WideStats;
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
-use raytrail::{load_scene, Builder, BUILTIN_SCENE};
+use raytrail::{Builder, BUILTIN_SCENE};
 use std::sync::Arc;
 
-const FLAGS: &[&str] = &["scene", "builder", "width", "height", "passes", "threads", "check-rays", "no-gpu"];
+const FLAGS: &[&str] = &["scene", "builder", "width", "height", "passes", "threads", "check-rays", "no-gpu", STRICT];
 
 /// One method's figures on a ray set: median seconds and counters.
 type Row = (Method, f64, Counters);
@@ -38,7 +38,7 @@ struct RaySetRun {
 }
 
 pub fn main(args: &[String]) -> Result<i32, String> {
-    let a = Args::parse(args, &["no-gpu"])?;
+    let a = Args::parse(args, &["no-gpu", STRICT])?;
     a.only(FLAGS)?;
     let scene_arg = a.get("scene").unwrap_or(BUILTIN_SCENE);
     let builder = Builder::from_name(a.get("builder").unwrap_or("sah"))?;
@@ -50,8 +50,9 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         None => CpuBackend::new(),
     };
 
-    let (named, _) = timed(&format!("loading {scene_arg}"), || load_scene(scene_arg));
-    let named = named?;
+    let (loaded, _) = timed(&format!("loading {scene_arg}"), || load_scene(scene_arg, &a.load_options()));
+    let (named, _, warning) = loaded?;
+    warn(&warning);
     let scene = &named.scene;
     let (bvh, build_s) =
         timed(&format!("building the BVH2 ({}, {} triangles)", builder.name(), scene.triangles().len()), || {

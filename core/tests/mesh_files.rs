@@ -8,7 +8,7 @@ mod common;
 
 mod mesh {
     use crate::common::scene_file;
-    use raytrail_core::mesh::{self, load, load_bytes};
+    use raytrail_core::mesh::{self, load, load_bytes, load_with, LoadOptions};
     use raytrail_core::scene::Mesh;
     use std::io::Write;
     use std::path::{Path, PathBuf};
@@ -100,7 +100,8 @@ mod mesh {
         }
     }
 
-    /// Loads `data` from a file named `file` in a scratch folder, removed afterwards.
+    /// Loads `data` from a file named `file` in a scratch folder, removed afterwards, with the
+    /// strict policy (every file here is meant to fail or load as a whole).
     fn load_file(file: &str, data: &[u8]) -> (PathBuf, Result<Mesh, mesh::MeshError>) {
         // One folder per call: tests run in parallel, and a shared folder could be removed by one
         // test while another writes into it.
@@ -110,7 +111,7 @@ mod mesh {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join(file);
         std::fs::write(&path, data).unwrap();
-        let result = load(&path);
+        let result = load_with(&path, &LoadOptions::STRICT).map(|(mesh, _)| mesh);
         let _ = std::fs::remove_dir_all(&dir);
         (path, result)
     }
@@ -143,9 +144,11 @@ property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_he
     #[test]
     fn obj_truncated_mid_line() {
         let whole = format!("{TRI_OBJ}v 1 1 0\nf 2 4 3\n");
-        // Cut inside the last face, and inside the last vertex.
+        // Cut inside the last face (an error when strict; by default the short face is skipped),
+        // and inside the last vertex.
         let e = fails("cut_face.obj", &whole.as_bytes()[..whole.len() - 3], ":7: ");
         assert!(e.contains("face has 2 vertices"), "{e}");
+        assert_eq!(load_bytes(&whole.as_bytes()[..whole.len() - 3], "cut_face.obj").unwrap().triangles.len(), 1);
         let e = fails("cut_vertex.obj", &whole.as_bytes()[..whole.len() - 12], ":6: ");
         assert!(e.contains("position parse error"), "{e}");
     }

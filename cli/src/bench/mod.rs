@@ -24,13 +24,13 @@ mod view;
 
 use crate::progress::{timed, Progress};
 use options::Options;
+use raytrail::core::mesh::LoadOptions;
 use raytrail::core::method::{Bvh2Method, Method, Query};
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::Trace;
 use raytrail::core::Hit;
 use raytrail::cpu::CpuScene;
 use raytrail::gpu::WgpuBackend;
-use raytrail::load_scene;
 use report::{BenchReport, Built, SceneReport};
 use std::sync::Arc;
 use target::{BenchTarget, RaytrailCpu, Targets};
@@ -106,8 +106,10 @@ fn bench_scene(
     pools: &[(usize, rayon::ThreadPool)],
     done: &mut dyn FnMut(&SceneReport),
 ) -> Result<Vec<SceneReport>, String> {
-    let (named, _) = timed(&format!("loading {path}"), || load_scene(path));
-    let named = named?;
+    let options = LoadOptions { strict: opts.strict, ..LoadOptions::default() };
+    let (loaded, _) = timed(&format!("loading {path}"), || crate::args::load_scene(path, &options));
+    let (named, _, warning) = loaded?;
+    crate::args::warn(&warning);
     let scene = &named.scene;
     let largest = &pools.last().ok_or("no thread pool")?.1;
 

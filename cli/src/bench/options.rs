@@ -2,14 +2,14 @@
 
 use super::rays::RayKind;
 use super::view::ViewChoice;
-use crate::args::Args;
+use crate::args::{Args, STRICT};
 use raytrail::core::method::Method;
 use raytrail::{Builder, BUILTIN_SCENE};
 
 /// Every flag `raytrail bench` knows.
 const FLAGS: &[&str] = &[
     "scene", "rays", "width", "height", "passes", "threads", "methods", "peers", "baseline", "json", "plot", "builder",
-    "ao-rays", "no-gpu", "view",
+    "ao-rays", "no-gpu", "view", STRICT,
 ];
 
 /// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
@@ -65,12 +65,14 @@ pub struct Options {
     pub no_gpu: bool,
     /// Which camera views each scene is measured from.
     pub view: ViewChoice,
+    /// Fail on mesh elements that are not triangles or polygons instead of skipping them.
+    pub strict: bool,
 }
 
 impl Options {
     /// Parses and checks the flags after `raytrail bench`.
     pub fn parse(args: &[String]) -> Result<Options, String> {
-        let a = Args::parse(args, &["no-gpu"])?;
+        let a = Args::parse(args, &["no-gpu", STRICT])?;
         a.only(FLAGS)?;
         let scenes = list(a.get("scene").unwrap_or(BUILTIN_SCENE));
         if scenes.is_empty() {
@@ -182,6 +184,7 @@ impl Options {
             ao_rays,
             no_gpu: a.has("no-gpu"),
             view: ViewChoice::from_name(a.get("view").unwrap_or(ViewChoice::DEFAULT.name()))?,
+            strict: a.has(STRICT),
         })
     }
 }
@@ -220,6 +223,7 @@ mod tests {
         assert_eq!(o.baseline, "obvhs-bvh2");
         assert_eq!(o.threads[0], 1);
         assert_eq!(o.view, ViewChoice::DEFAULT);
+        assert!(!o.strict && parse("--strict").unwrap().strict);
         assert_eq!(parse("--view both").unwrap().view, ViewChoice::Both);
         let e = parse("--scene a.obj --colour red").unwrap_err();
         assert!(e.contains("unknown flag --colour"), "{e}");

@@ -1,34 +1,230 @@
-//! Mesh files: OBJ (through tobj) and PLY (ASCII and binary, optionally gzip).
+//! Mesh files: OBJ (through tobj), PLY (ASCII and binary), OFF, STL (binary and ASCII) and glTF 2.0
+//! (`.gltf` and `.glb`, through the `gltf` crate's JSON model); any of them gzip-compressed.
 //!
-//! Every loader returns a [`Mesh`] whose primitive id is the triangle index in file order, with
-//! polygons split as fans `(v0, vi, vi+1)`. Every failure is a [`MeshError`] naming the file and,
-//! where there is one, the line (text) or byte offset (binary PLY).
+//! # Primitive ids
+//!
+//! Every loader returns a [`Mesh`] whose primitive id is the index of the triangle in file order
+//! over the triangles kept, polygons split as fans `(v0, vi, vi+1)`:
+//! - OBJ: `f` lines in file order (across `o`, `g` and material changes);
+//! - PLY, OFF: the face elements in order;
+//! - STL: the facets in order (across the solids of an ASCII file);
+//! - glTF: the scene's nodes depth first, in the order the scene and each node list them (a node
+//!   before its children); per node with a mesh, its primitives in order; per primitive, its
+//!   triangles in order, triangle strips and fans converted as the glTF specification numbers
+//!   them. A mesh used by several nodes is there once per node, transformed by each.
+//!
+//! [`LoadReport::sources`] (with [`LoadOptions::sources`]) gives, per primitive id, where in the
+//! file the triangle came from ([`Source`]).
+//!
+//! # Loading policy
+//!
+//! Elements that are not triangles or polygons (faces of fewer than three vertices, OBJ `l`
+//! polylines and `p` points, STL loops of fewer than three vertices, glTF primitives in a point or
+//! line mode) are skipped and counted in the [`LoadReport`], which keeps the first one's location.
+//! With [`LoadOptions::strict`] the first of them is an error instead (for short faces, the error
+//! the loaders gave before they learned to skip: "face has 2 vertices; a face needs at least 3").
+//!
+//! # Errors and limits
+//!
+//! Every failure is a [`MeshError`] naming the file and, where there is one, the line (text), the
+//! byte offset (binary) or the JSON path (glTF). Counts that a file claims (PLY and OFF headers,
+//! STL's triangle count, glTF accessors) never size an allocation beyond what the data can hold,
+//! and no input makes a loader panic.
 
 mod error;
+mod gltf;
 mod obj;
+mod off;
 mod ply;
+mod stl;
 
 pub use error::MeshError;
 
 use crate::scene::Mesh;
-use std::io::{BufRead, Read};
+use core::fmt;
+use std::io::{self, BufRead, Read, Write};
 use std::path::Path;
-use std::string::ToString;
+use std::string::{String, ToString};
 use std::vec::Vec;
 
-/// Loads a mesh file: `.obj`, `.ply`, and either of them gzip-compressed (`.obj.gz`, `.ply.gz`).
+/// How a file is loaded.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Fail on the first element that is not a triangle or polygon, instead of skipping it.
+    pub strict: bool,
+    /// Fill [`LoadReport::sources`]: where in the file each kept triangle comes from.
+    pub sources: bool,
+}
+
+impl LoadOptions {
+    /// The default policy: skip elements that are not triangles or polygons, no source map.
+    pub const LENIENT: LoadOptions = LoadOptions { strict: false, sources: false };
+    /// Fail on elements that are not triangles or polygons.
+    pub const STRICT: LoadOptions = LoadOptions { strict: true, sources: false };
+}
+
+/// What loading a file skipped, and where the triangles came from.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LoadReport {
+    /// Elements skipped because they are not triangles or polygons.
+    pub skipped: usize,
+    /// The first of them.
+    pub first_skipped: Option<Skipped>,
+    /// Per primitive id, where the triangle came from; empty unless [`LoadOptions::sources`].
+    pub sources: Vec<Source>,
+}
+
+/// An element that loading skipped: where it is, and what it is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Skipped {
+    /// Where in the file: `line 7`, `face 12 (line 30)`, `mesh 2 primitive 0 (node 5)`.
+    pub location: String,
+    /// What it is: `a face with 2 vertices`, `a polyline (l)`, `a primitive in LINES mode`.
+    pub what: String,
+}
+
+/// Where in its file a triangle came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// The 1-based line of its OBJ `f` statement.
+    Line(u64),
+    /// The 0-based index of its face element (PLY, OFF).
+    Face(u64),
+    /// The 0-based index of its STL facet (counted across solids).
+    Facet(u64),
+    /// glTF: the node that places it, its mesh, the primitive in the mesh, and the triangle in the
+    /// primitive (after strip and fan conversion); all 0-based.
+    Gltf {
+        /// Node index.
+        node: u32,
+        /// Mesh index.
+        mesh: u32,
+        /// Primitive index within the mesh.
+        primitive: u32,
+        /// Triangle index within the primitive.
+        triangle: u32,
+    },
+}
+
+impl Source {
+    /// The CSV column names of this kind of source.
+    pub fn columns(&self) -> &'static str {
+        match self {
+            Source::Line(_) => "line",
+            Source::Face(_) => "face",
+            Source::Facet(_) => "facet",
+            Source::Gltf { .. } => "node,mesh,primitive,triangle",
+        }
+    }
+}
+
+/// The values, comma-separated, in the order of [`Source::columns`].
+impl fmt::Display for Source {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Source::Line(v) | Source::Face(v) | Source::Facet(v) => write!(f, "{v}"),
+            Source::Gltf { node, mesh, primitive, triangle } => write!(f, "{node},{mesh},{primitive},{triangle}"),
+        }
+    }
+}
+
+impl LoadReport {
+    /// Counts a skipped element, keeping the first one's description.
+    pub(crate) fn skip(&mut self, location: impl FnOnce() -> String, what: impl FnOnce() -> String) {
+        self.skipped += 1;
+        if self.first_skipped.is_none() {
+            self.first_skipped = Some(Skipped { location: location(), what: what() });
+        }
+    }
+
+    /// One line saying what was skipped in `file`, or `None` when nothing was: `a.obj: skipped 3
+    /// elements that are not triangles or polygons, the first at line 7: a face with 2 vertices`.
+    pub fn summary(&self, file: &str) -> Option<String> {
+        let first = self.first_skipped.as_ref()?;
+        let (n, Skipped { location, what }) = (self.skipped, first);
+        Some(if n == 1 {
+            std::format!("{file}: skipped 1 element that is not a triangle or polygon, at {location}: {what}")
+        } else {
+            std::format!(
+                "{file}: skipped {n} elements that are not triangles or polygons, the first at {location}: {what}"
+            )
+        })
+    }
+}
+
+/// Writes the primitive-id map of [`LoadReport::sources`] as CSV: a header `prim,file,<columns>`
+/// ([`Source::columns`]), then one row per triangle, `file` quoted where CSV needs it.
+pub fn write_sources_csv(out: &mut impl Write, file: &str, sources: &[Source]) -> io::Result<()> {
+    let columns = sources.first().map_or("source", Source::columns);
+    let file = if file.contains([',', '"', '\n', '\r']) {
+        std::format!("\"{}\"", file.replace('"', "\"\""))
+    } else {
+        file.to_string()
+    };
+    writeln!(out, "prim,file,{columns}")?;
+    for (prim, source) in sources.iter().enumerate() {
+        writeln!(out, "{prim},{file},{source}")?;
+    }
+    Ok(())
+}
+
+/// Loads a mesh file with the default (lenient) policy; see [`load_with`].
+pub fn load(path: &Path) -> Result<Mesh, MeshError> {
+    load_with(path, &LoadOptions::default()).map(|(mesh, _)| mesh)
+}
+
+/// Loads a mesh file: `.obj`, `.ply`, `.off`, `.stl`, `.gltf`, `.glb`, each optionally gzip
+/// compressed (`.obj.gz`, ...).
 ///
 /// Gzip is recognised by its magic bytes, whatever the name; the format then comes from the
-/// extension (after any `.gz`), or from the content for other names (`ply` magic, else an error).
-pub fn load(path: &Path) -> Result<Mesh, MeshError> {
+/// extension (after any `.gz`), or from the content for other names (PLY, OFF, GLB and glTF JSON
+/// by their first bytes; STL by its `solid` keyword or its size). A `.gltf` file's external
+/// buffers are read from the file's folder.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<(Mesh, LoadReport), MeshError> {
     let name = path.display().to_string();
     let data = std::fs::read(path).map_err(|e| MeshError::io(&name, "cannot read file", e))?;
-    load_bytes(&data, &name)
+    let dir = path.parent().map(|d| if d.as_os_str().is_empty() { Path::new(".") } else { d });
+    load_data(&data, &name, dir, options)
+}
+
+/// Loads a mesh from file contents held in memory with the default (lenient) policy; see
+/// [`load_bytes_with`].
+pub fn load_bytes(data: &[u8], name: &str) -> Result<Mesh, MeshError> {
+    load_bytes_with(data, name, &LoadOptions::default()).map(|(mesh, _)| mesh)
 }
 
 /// Loads a mesh from file contents held in memory; `name` is used for the format (as in
-/// [`load`]) and in errors.
-pub fn load_bytes(data: &[u8], name: &str) -> Result<Mesh, MeshError> {
+/// [`load_with`]) and in errors. A glTF file's buffers must be in the data (GLB, `data:` URIs):
+/// no other file is read.
+pub fn load_bytes_with(data: &[u8], name: &str, options: &LoadOptions) -> Result<(Mesh, LoadReport), MeshError> {
+    load_data(data, name, None, options)
+}
+
+/// Parses an OBJ file from a reader with the default (lenient) policy; `name` is used in errors.
+/// Materials are ignored.
+pub fn load_obj(mut reader: impl BufRead, name: &str) -> Result<Mesh, MeshError> {
+    let mut data = Vec::new();
+    reader.read_to_end(&mut data).map_err(|e| MeshError::io(name, "read failed", e))?;
+    obj::parse(&data, name, &LoadOptions::default()).map(|(mesh, _)| mesh)
+}
+
+/// Parses a PLY file (ASCII, binary little- or big-endian) from a reader with the default
+/// (lenient) policy; `name` is used in errors. Takes vertex `x`, `y`, `z` and the face list
+/// `vertex_indices` (or `vertex_index`).
+pub fn load_ply(mut reader: impl BufRead, name: &str) -> Result<Mesh, MeshError> {
+    let mut data = Vec::new();
+    reader.read_to_end(&mut data).map_err(|e| MeshError::io(name, "read failed", e))?;
+    ply::parse(&data, name, &LoadOptions::default()).map(|(mesh, _)| mesh)
+}
+
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
+fn load_data(
+    data: &[u8],
+    name: &str,
+    dir: Option<&Path>,
+    options: &LoadOptions,
+) -> Result<(Mesh, LoadReport), MeshError> {
     if data.is_empty() {
         return Err(MeshError::new(name, "file is empty"));
     }
@@ -38,39 +234,69 @@ pub fn load_bytes(data: &[u8], name: &str) -> Result<Mesh, MeshError> {
         if raw.is_empty() {
             return Err(MeshError::new(name, "file is empty after gzip decompression"));
         }
-        return parse(&raw, name, stem.unwrap_or(name));
+        return parse(&raw, name, stem.unwrap_or(name), dir, options);
     }
     if stem.is_some() {
         return Err(MeshError::new(name, "named .gz but not gzip data (no 1f 8b magic)"));
     }
-    parse(data, name, name)
+    parse(data, name, name, dir, options)
 }
 
-/// Parses an OBJ file from a reader; `name` is used in errors. Materials are ignored.
-pub fn load_obj(mut reader: impl BufRead, name: &str) -> Result<Mesh, MeshError> {
-    let mut data = Vec::new();
-    reader.read_to_end(&mut data).map_err(|e| MeshError::io(name, "read failed", e))?;
-    obj::parse(&data, name)
+/// The formats, as [`parse`] tells them apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Obj,
+    Ply,
+    Off,
+    Stl,
+    /// glTF JSON or GLB: the loader tells them apart by the GLB magic.
+    Gltf,
 }
 
-/// Parses a PLY file (ASCII, binary little- or big-endian) from a reader; `name` is used in
-/// errors. Takes vertex `x`, `y`, `z` and the face list `vertex_indices` (or `vertex_index`).
-pub fn load_ply(mut reader: impl BufRead, name: &str) -> Result<Mesh, MeshError> {
-    let mut data = Vec::new();
-    reader.read_to_end(&mut data).map_err(|e| MeshError::io(name, "read failed", e))?;
-    ply::parse(&data, name)
+fn format_of(format_name: &str, data: &[u8]) -> Option<Format> {
+    const EXTENSIONS: [(&str, Format); 6] = [
+        (".obj", Format::Obj),
+        (".ply", Format::Ply),
+        (".off", Format::Off),
+        (".stl", Format::Stl),
+        (".gltf", Format::Gltf),
+        (".glb", Format::Gltf),
+    ];
+    if let Some(&(_, format)) = EXTENSIONS.iter().find(|(ext, _)| strip_suffix_ignore_case(format_name, ext).is_some())
+    {
+        return Some(format);
+    }
+    if ply::has_magic(data) {
+        Some(Format::Ply)
+    } else if gltf::has_magic(data) {
+        Some(Format::Gltf)
+    } else if off::has_magic(data) {
+        Some(Format::Off)
+    } else if stl::has_magic(data) {
+        Some(Format::Stl)
+    } else {
+        None
+    }
 }
-
-const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 
 /// Picks the format by `format_name`'s extension, else by content.
-fn parse(data: &[u8], name: &str, format_name: &str) -> Result<Mesh, MeshError> {
-    if strip_suffix_ignore_case(format_name, ".obj").is_some() {
-        obj::parse(data, name)
-    } else if strip_suffix_ignore_case(format_name, ".ply").is_some() || ply::has_magic(data) {
-        ply::parse(data, name)
-    } else {
-        Err(MeshError::new(name, "unknown mesh format: expected .obj or .ply (optionally .gz)"))
+fn parse(
+    data: &[u8],
+    name: &str,
+    format_name: &str,
+    dir: Option<&Path>,
+    options: &LoadOptions,
+) -> Result<(Mesh, LoadReport), MeshError> {
+    match format_of(format_name, data) {
+        Some(Format::Obj) => obj::parse(data, name, options),
+        Some(Format::Ply) => ply::parse(data, name, options),
+        Some(Format::Off) => off::parse(data, name, options),
+        Some(Format::Stl) => stl::parse(data, name, options),
+        Some(Format::Gltf) => gltf::parse(data, name, dir, options),
+        None => Err(MeshError::new(
+            name,
+            "unknown mesh format: expected .obj, .ply, .off, .stl, .gltf or .glb (optionally .gz)",
+        )),
     }
 }
 
@@ -89,6 +315,34 @@ fn strip_suffix_ignore_case<'a>(s: &'a str, suffix: &str) -> Option<&'a str> {
     tail.eq_ignore_ascii_case(suffix).then_some(head)
 }
 
+/// The words of a line of text, split at ASCII whitespace.
+fn words(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    line.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty())
+}
+
+/// A byte string for messages, shortened.
+fn show(bytes: &[u8]) -> String {
+    let text = String::from_utf8_lossy(bytes);
+    match text.char_indices().nth(40) {
+        Some((cut, _)) => std::format!("{}...", &text[..cut]),
+        None => text.into_owned(),
+    }
+}
+
+/// The message of a caught panic.
+fn panic_message(payload: std::boxed::Box<dyn std::any::Any + Send>) -> String {
+    match payload.downcast::<String>() {
+        Ok(s) => *s,
+        Err(payload) => payload.downcast_ref::<&str>().map_or_else(|| String::from("unknown panic"), |s| (*s).into()),
+    }
+}
+
+/// The most vertices a mesh may have: indices are `u32`.
+const MAX_VERTICES: u64 = 1 << 32;
+
+/// The most triangles a mesh may have: primitive ids are `u32`, and `u32::MAX` marks a miss.
+const MAX_TRIANGLES: u64 = u32::MAX as u64;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,6 +359,9 @@ mod tests {
     const TRI_PLY: &[u8] = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
 property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
 0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    const TRI_OFF: &[u8] = b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    const TRI_STL: &[u8] = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n\
+endloop\nendfacet\nendsolid t\n";
 
     #[test]
     fn dispatch_by_extension_and_gzip_magic() {
@@ -114,6 +371,23 @@ property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_he
         assert_eq!(load_bytes(&gzip(QUAD_OBJ), "a.obj").unwrap().triangles.len(), 2);
         assert_eq!(load_bytes(&gzip(TRI_PLY), "a.ply.gz").unwrap().triangles, [[0, 1, 2]]);
         assert_eq!(load_bytes(TRI_PLY, "no_extension").unwrap().triangles, [[0, 1, 2]]);
+        assert_eq!(load_bytes(TRI_OFF, "a.Off").unwrap().triangles, [[0, 1, 2]]);
+        assert_eq!(load_bytes(&gzip(TRI_STL), "a.stl.gz").unwrap().triangles, [[0, 1, 2]]);
+    }
+
+    #[test]
+    fn dispatch_by_content() {
+        assert_eq!(load_bytes(TRI_OFF, "mesh.data").unwrap().triangles, [[0, 1, 2]]);
+        assert_eq!(load_bytes(TRI_STL, "mesh.data").unwrap().triangles, [[0, 1, 2]]);
+        let gltf = br#"{"asset":{"version":"2.0"}}"#;
+        assert_eq!(load_bytes(gltf, "mesh.data").unwrap(), Mesh::default());
+        assert_eq!(format_of("x", b"glTF\x02\0\0\0"), Some(Format::Gltf));
+        assert_eq!(format_of("x", b"\xef\xbb\xbf {\"asset\""), Some(Format::Gltf));
+        // A binary STL whose size matches its count, with no `solid` keyword.
+        let mut bin = std::vec![0u8; 84 + 50];
+        bin[80] = 1;
+        assert_eq!(format_of("x", &bin), Some(Format::Stl));
+        assert_eq!(format_of("x", QUAD_OBJ), None);
     }
 
     #[test]
@@ -122,8 +396,8 @@ property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_he
         assert_eq!(format!("{e}"), "empty.obj: file is empty");
         let e = load_bytes(QUAD_OBJ, "plain.obj.gz").unwrap_err();
         assert!(format!("{e}").starts_with("plain.obj.gz: named .gz"), "{e}");
-        let e = load_bytes(QUAD_OBJ, "mesh.stl").unwrap_err();
-        assert!(format!("{e}").starts_with("mesh.stl: unknown mesh format"), "{e}");
+        let e = load_bytes(QUAD_OBJ, "mesh.3ds").unwrap_err();
+        assert!(format!("{e}").starts_with("mesh.3ds: unknown mesh format"), "{e}");
         let e = load_bytes(&gzip(b""), "nothing.ply.gz").unwrap_err();
         assert!(format!("{e}").contains("empty after gzip"), "{e}");
     }
@@ -153,5 +427,31 @@ property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_he
     fn readers_parse_from_memory() {
         assert_eq!(load_obj(QUAD_OBJ, "q.obj").unwrap().positions.len(), 4);
         assert_eq!(load_ply(TRI_PLY, "t.ply").unwrap().positions.len(), 3);
+    }
+
+    #[test]
+    fn report_summary_and_csv() {
+        let mut report = LoadReport::default();
+        assert_eq!(report.summary("a.obj"), None);
+        report.skip(|| "line 7".into(), || "a face with 2 vertices".into());
+        assert_eq!(
+            report.summary("a.obj").unwrap(),
+            "a.obj: skipped 1 element that is not a triangle or polygon, at line 7: a face with 2 vertices"
+        );
+        report.skip(|| "line 9".into(), || "a polyline (l)".into());
+        assert_eq!(
+            report.summary("a.obj").unwrap(),
+            "a.obj: skipped 2 elements that are not triangles or polygons, the first at line 7: a face with 2 vertices"
+        );
+        let mut csv = Vec::new();
+        write_sources_csv(&mut csv, "a,b.obj", &[Source::Line(3), Source::Line(3), Source::Line(5)]).unwrap();
+        assert_eq!(
+            String::from_utf8(csv).unwrap(),
+            "prim,file,line\n0,\"a,b.obj\",3\n1,\"a,b.obj\",3\n2,\"a,b.obj\",5\n"
+        );
+        let mut csv = Vec::new();
+        let g = Source::Gltf { node: 1, mesh: 2, primitive: 3, triangle: 4 };
+        write_sources_csv(&mut csv, "m.glb", &[g]).unwrap();
+        assert_eq!(String::from_utf8(csv).unwrap(), "prim,file,node,mesh,primitive,triangle\n0,m.glb,1,2,3,4\n");
     }
 }

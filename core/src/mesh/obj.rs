@@ -9,16 +9,20 @@
 //!   file): [`locate_bad_reference`] rescans to find the face that caused them.
 //! - It reads `l` (polyline) statements as faces, so `l 1 2 3` would become a triangle: such lines
 //!   are turned into comments before tobj sees them.
-//! - It silently turns faces of one or two vertices into degenerate triangles (or drops them):
-//!   these are rejected here, like in PLY.
+//! - It silently turns faces of one or two vertices into degenerate triangles (or drops them): by
+//!   the loading policy ([`super::LoadOptions`]) these are commented out too and counted, or with
+//!   `strict` rejected, like `l` and `p` statements.
 //! - Arithmetic on hostile indices can overflow inside tobj (a panic with overflow checks on): the
 //!   call is guarded and the panic reported as an error.
+//!
+//! The source of each triangle ([`Source::Line`]) comes from the same pre-scan: tobj keeps file
+//! order and splits an `f` of `n` vertices into `n - 2` triangles, so the kept `f` lines, each
+//! repeated `n - 2` times, line up with its triangles (checked against the count it returns).
 
-use super::MeshError;
+use super::{LoadOptions, LoadReport, MeshError, Source};
 use crate::scene::Mesh;
 use glam::Vec3;
 use std::borrow::Cow;
-use std::boxed::Box;
 use std::format;
 use std::io::{self, BufRead, Read};
 use std::panic::{self, AssertUnwindSafe};
@@ -26,20 +30,20 @@ use std::string::String;
 use std::vec::Vec;
 
 /// Parses OBJ text; `name` is used in errors.
-pub(super) fn parse(data: &[u8], name: &str) -> Result<Mesh, MeshError> {
-    let scan = prescan(data);
-    let text: Cow<[u8]> = if scan.polylines.is_empty() {
+pub(super) fn parse(data: &[u8], name: &str, options: &LoadOptions) -> Result<(Mesh, LoadReport), MeshError> {
+    let mut scan = prescan(data, options);
+    let text: Cow<[u8]> = if scan.comment_out.is_empty() {
         Cow::Borrowed(data)
     } else {
         let mut owned = data.to_vec();
-        for &at in &scan.polylines {
+        for &at in &scan.comment_out {
             owned[at] = b'#';
         }
         Cow::Owned(owned)
     };
 
     let mut reader = Tracked { data: &text, pos: 0 };
-    let options = tobj::LoadOptions {
+    let tobj_options = tobj::LoadOptions {
         triangulate: true,
         // Separate position indices: positions are not duplicated per normal/texcoord.
         single_index: false,
@@ -48,30 +52,40 @@ pub(super) fn parse(data: &[u8], name: &str) -> Result<Mesh, MeshError> {
     };
     // Materials are not needed; a failing loader only records the failure in tobj's result.
     let result = panic::catch_unwind(AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
+        tobj::load_obj_buf(&mut reader, &tobj_options, |_| Err(tobj::LoadError::OpenFileFailed))
     }));
     let tobj_line = reader.line();
 
     let failure = match result {
         Ok(Ok((models, _materials))) => {
-            if let Some((line, n)) = scan.short_face {
-                return Err(short_face(name, line, n));
+            if let Some((line, msg)) = scan.strict_error {
+                return Err(MeshError::at_line(name, line, msg));
             }
-            return concat(models, name);
+            let mesh = concat(models, name)?;
+            if options.sources && scan.report.sources.len() != mesh.triangles.len() {
+                let msg = format!(
+                    "tobj returned {} triangles where the `f` lines make {}",
+                    mesh.triangles.len(),
+                    scan.report.sources.len()
+                );
+                return Err(MeshError::new(name, msg));
+            }
+            return Ok((mesh, scan.report));
         }
         Ok(Err(err)) => (err, None),
-        Err(payload) => (tobj::LoadError::GenericFailure, Some(panic_message(payload))),
+        Err(payload) => (tobj::LoadError::GenericFailure, Some(super::panic_message(payload))),
     };
-    Err(locate_failure(&text, name, tobj_line, failure, scan.short_face))
+    Err(locate_failure(&text, name, tobj_line, failure, scan.strict_error.take()))
 }
 
-/// The first problem tobj ran into, positioned; a short face before it wins.
+/// The first problem tobj ran into, positioned; an element that strict loading rejects wins if
+/// it comes first.
 fn locate_failure(
     text: &[u8],
     name: &str,
     tobj_line: usize,
     (err, panic_msg): (tobj::LoadError, Option<String>),
-    short: Option<(usize, usize)>,
+    strict: Option<(usize, String)>,
 ) -> MeshError {
     use tobj::LoadError as E;
     let deferred = panic_msg.is_some()
@@ -92,16 +106,12 @@ fn locate_failure(
         None if deferred => MeshError::at_line(name, tobj_line, format!("{what} in the object ending here")),
         None => MeshError::at_line(name, tobj_line, format!("{what}: {}", quote_line(text, tobj_line))),
     };
-    if let Some((line, n)) = short {
+    if let Some((line, msg)) = strict {
         if found.line.is_none_or(|l| line <= l) {
-            found = short_face(name, line, n);
+            found = MeshError::at_line(name, line, msg);
         }
     }
     found
-}
-
-fn short_face(name: &str, line: usize, vertices: usize) -> MeshError {
-    MeshError::at_line(name, line, format!("face has {vertices} vertices; a face needs at least 3"))
 }
 
 /// Appends tobj's models in order, offsetting each model's indices past the positions before it.
@@ -126,25 +136,62 @@ fn concat(models: Vec<tobj::Model>, name: &str) -> Result<Mesh, MeshError> {
 
 /// What a quick pass over the text finds before tobj runs.
 struct Prescan {
-    /// Byte offsets of the `l` keyword of polyline statements.
-    polylines: Vec<usize>,
-    /// The first face with fewer than 3 vertices: (line, vertex count).
-    short_face: Option<(usize, usize)>,
+    /// Byte offsets of the keywords of statements to turn into comments: `l` always (tobj would
+    /// read it as a face), and faces of fewer than 3 vertices when not strict.
+    comment_out: Vec<usize>,
+    /// With strict loading, the first element that is not a triangle or polygon: its line and
+    /// the error.
+    strict_error: Option<(usize, String)>,
+    /// Elements skipped, and the sources of the triangles of the kept faces.
+    report: LoadReport,
 }
 
-fn prescan(data: &[u8]) -> Prescan {
-    let mut scan = Prescan { polylines: Vec::new(), short_face: None };
+fn prescan(data: &[u8], options: &LoadOptions) -> Prescan {
+    let mut scan = Prescan { comment_out: Vec::new(), strict_error: None, report: LoadReport::default() };
     for (i, (start, line)) in lines(data).enumerate() {
-        let mut words = words(line);
-        match words.next() {
-            Some(b"l") => scan.polylines.push(start + first_word_offset(line)),
-            Some(b"f") if scan.short_face.is_none() => {
-                let n = words.count();
-                if n < 3 {
-                    scan.short_face = Some((i + 1, n));
-                }
+        let line_no = i + 1;
+        // Words as tobj splits them (Unicode whitespace) where the line is text it can read.
+        let (keyword, count) = match std::str::from_utf8(line) {
+            Ok(text) => {
+                let mut w = text.split_whitespace();
+                (w.next().map(str::as_bytes), w.count())
             }
-            _ => {}
+            Err(_) => {
+                let mut w = words(line);
+                (w.next(), w.count())
+            }
+        };
+        let keyword_at = start + first_word_offset(line);
+        let skipped = match keyword {
+            Some(b"l") => {
+                scan.comment_out.push(keyword_at);
+                Some(("a polyline (l)".into(), "a polyline (l) is not a triangle or polygon".into()))
+            }
+            Some(b"p") => Some(("points (p)".into(), "points (p) are not triangles or polygons".into())),
+            Some(b"f") if count < 3 => {
+                if !options.strict {
+                    scan.comment_out.push(keyword_at);
+                }
+                let what = format!("a face with {count} vertices");
+                Some((what, format!("face has {count} vertices; a face needs at least 3")))
+            }
+            Some(b"f") => {
+                if options.sources {
+                    let n = count - 2;
+                    scan.report.sources.extend(core::iter::repeat_n(Source::Line(line_no as u64), n));
+                }
+                None
+            }
+            _ => None,
+        };
+        if let Some((what, error)) = skipped {
+            if options.strict {
+                if scan.strict_error.is_none() {
+                    scan.strict_error = Some((line_no, error));
+                }
+            } else {
+                scan.report.skip(|| format!("line {line_no}"), || what);
+            }
         }
     }
     scan
@@ -225,13 +272,6 @@ fn quote_line(data: &[u8], line: usize) -> String {
     }
 }
 
-fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
-    match payload.downcast::<String>() {
-        Ok(s) => *s,
-        Err(payload) => payload.downcast_ref::<&str>().map_or_else(|| String::from("unknown panic"), |s| (*s).into()),
-    }
-}
-
 /// A reader over the text that remembers how far it has been consumed, so that tobj's position
 /// is known when it fails. Newlines are counted only then, keeping the hot path a pointer bump.
 struct Tracked<'a> {
@@ -274,14 +314,23 @@ mod tests {
     use super::*;
     use std::string::ToString;
 
+    /// The error of strict loading.
     fn err(text: &str) -> String {
-        parse(text.as_bytes(), "t.obj").unwrap_err().to_string()
+        parse(text.as_bytes(), "t.obj", &LoadOptions::STRICT).unwrap_err().to_string()
+    }
+
+    fn load(text: &str) -> Mesh {
+        lenient(text).0
+    }
+
+    fn lenient(text: &str) -> (Mesh, LoadReport) {
+        parse(text.as_bytes(), "t.obj", &LoadOptions { strict: false, sources: true }).unwrap()
     }
 
     #[test]
     fn fans_in_file_order_across_objects() {
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 2 0\no a\nf 1 2 3 4 5\ng b\nf 3 2 1\no a\nf -1 -2 -3\n";
-        let m = parse(text.as_bytes(), "t.obj").unwrap();
+        let m = load(text);
         let tris: Vec<[Vec3; 3]> = m.triangles.iter().map(|t| t.map(|i| m.positions[i as usize])).collect();
         let v = |i: usize| [Vec3::ZERO, Vec3::X, Vec3::new(1., 1., 0.), Vec3::Y, Vec3::new(2., 2., 0.)][i - 1];
         let want = [[1, 2, 3], [1, 3, 4], [1, 4, 5], [3, 2, 1], [5, 4, 3]].map(|t| t.map(v));
@@ -291,21 +340,51 @@ mod tests {
     #[test]
     fn quads_and_texcoord_normal_forms() {
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3//1 4/1\n";
-        let m = parse(text.as_bytes(), "t.obj").unwrap();
+        let m = load(text);
         assert_eq!(m.triangles.len(), 2);
         assert_eq!(m.triangles[1].map(|i| m.positions[i as usize]), [Vec3::ZERO, Vec3::new(1., 1., 0.), Vec3::Y]);
     }
 
     #[test]
+    fn sources_are_the_f_lines() {
+        let text =
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 2 0\no a\nf 1 2 3 4 5\ng b\n\nf 3 2 1\nusemtl x\nf 1\u{a0}2 3 4\n";
+        let (m, report) = lenient(text);
+        assert_eq!(m.triangles.len(), 6);
+        assert_eq!(report.sources, [7, 7, 7, 10, 12, 12].map(Source::Line));
+        assert_eq!(report.skipped, 0);
+        // Without the option, no map.
+        let (_, report) = parse(text.as_bytes(), "t.obj", &LoadOptions::default()).unwrap();
+        assert!(report.sources.is_empty());
+    }
+
+    #[test]
+    fn short_faces_lines_and_points_are_skipped_and_counted() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2\nf 1 2 3\nl 1 2 3\np 1\nf 3\nf\nf 3 2 1\n";
+        let (m, report) = lenient(text);
+        assert_eq!(m.triangles, [[0, 1, 2], [2, 1, 0]]);
+        assert_eq!(report.sources, [Source::Line(5), Source::Line(10)]);
+        assert_eq!(report.skipped, 5);
+        let first = report.first_skipped.unwrap();
+        assert_eq!((first.location.as_str(), first.what.as_str()), ("line 4", "a face with 2 vertices"));
+        // Strict: the first of them, with the message of before.
+        assert_eq!(err(text), "t.obj:4: face has 2 vertices; a face needs at least 3");
+        assert_eq!(err("v 0 0 0\nl 1 1\nf 1 2\n"), "t.obj:2: a polyline (l) is not a triangle or polygon");
+        assert_eq!(err("v 0 0 0\n  p 1\n"), "t.obj:2: points (p) are not triangles or polygons");
+        // A skipped face's references are not checked.
+        assert_eq!(load("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 99\nf 1 2 3\n").triangles.len(), 1);
+    }
+
+    #[test]
     fn polylines_are_not_triangles() {
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\n  l 1 2 3\nl 1 2\nf 1 2 3\n";
-        assert_eq!(parse(text.as_bytes(), "t.obj").unwrap().triangles.len(), 1);
+        assert_eq!(load(text).triangles.len(), 1);
     }
 
     #[test]
     fn materials_are_ignored() {
         let text = "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl red\nf 1 2 3\nusemtl blue\nf 3 2 1\n";
-        assert_eq!(parse(text.as_bytes(), "t.obj").unwrap().triangles.len(), 2);
+        assert_eq!(load(text).triangles.len(), 2);
     }
 
     #[test]
@@ -341,7 +420,8 @@ mod tests {
 
     #[test]
     fn invalid_utf8_is_an_error_at_its_line() {
-        let e = parse(b"v 0 0 0\n\xff\xfe garbage\nv 1 1 1\n", "g.obj").unwrap_err().to_string();
+        let e =
+            parse(b"v 0 0 0\n\xff\xfe garbage\nv 1 1 1\n", "g.obj", &LoadOptions::default()).unwrap_err().to_string();
         assert!(e.starts_with("g.obj:2: read error"), "{e}");
     }
 

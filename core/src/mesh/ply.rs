@@ -3,8 +3,11 @@
 //! Only vertex `x`, `y`, `z` and the face list `vertex_indices` (or `vertex_index`) are kept;
 //! every other element and property is read past (and checked) so that the layout stays in step.
 //! ASCII errors give the line; binary errors give the byte offset and the element's index.
+//! Faces of fewer than three vertices are skipped and counted, or rejected when loading is strict
+//! (their indices are read past either way); other elements (`edge`, ...) are read past as
+//! always, not counted. The source of a triangle is its face element's index ([`Source::Face`]).
 
-use super::MeshError;
+use super::{LoadOptions, LoadReport, MeshError, Source};
 use crate::scene::Mesh;
 use glam::Vec3;
 use std::format;
@@ -17,9 +20,16 @@ pub(super) fn has_magic(data: &[u8]) -> bool {
 }
 
 /// Parses a whole PLY file held in memory; `name` is used in errors.
-pub(super) fn parse(data: &[u8], name: &str) -> Result<Mesh, MeshError> {
+pub(super) fn parse(data: &[u8], name: &str, options: &LoadOptions) -> Result<(Mesh, LoadReport), MeshError> {
     let header = Header::parse(data, name)?;
-    let mut out = Out { mesh: Mesh::default(), vertices: header.vertex_count };
+    let mut out = Out {
+        mesh: Mesh::default(),
+        vertices: header.vertex_count,
+        options: *options,
+        report: LoadReport::default(),
+        face: 0,
+        short: None,
+    };
     // Reserve what the header declares, but no more than the data could hold (hostile counts).
     for el in &header.elements {
         match el.kind {
@@ -32,7 +42,7 @@ pub(super) fn parse(data: &[u8], name: &str) -> Result<Mesh, MeshError> {
         Format::Ascii => read_ascii(data, name, &header, &mut out)?,
         Format::Binary { big_endian } => read_binary(data, name, &header, big_endian, &mut out)?,
     }
-    Ok(out.mesh)
+    Ok((out.mesh, out.report))
 }
 
 /// A PLY scalar type.
@@ -297,10 +307,25 @@ fn parse_property(w: &[&[u8]], element: ElementKind) -> Result<Property, String>
     Ok(Property { name, kind, role })
 }
 
-/// The mesh being filled, and how many vertices indices may refer to.
+/// The mesh being filled, how many vertices indices may refer to, and the loading policy.
 struct Out {
     mesh: Mesh,
     vertices: i64,
+    options: LoadOptions,
+    report: LoadReport,
+    /// Index of the face element being read.
+    face: u64,
+    /// The vertex count of a face just skipped, for the caller to position it.
+    short: Option<i64>,
+}
+
+impl Out {
+    /// Positions the face that [`read_face`] just skipped, if it skipped one.
+    fn note_skipped(&mut self, location: impl FnOnce() -> String) {
+        if let Some(n) = self.short.take() {
+            self.report.skip(location, || format!("a face with {n} vertices"));
+        }
+    }
 }
 
 /// A source of property values: ASCII tokens or binary numbers. Errors are short messages that
@@ -343,10 +368,18 @@ fn read_element(v: &mut impl Values, el: &Element, out: &mut Out) -> Result<(), 
     Ok(())
 }
 
-/// Reads `n` vertex indices and appends their fan `(v0, vi, vi+1)`.
+/// Reads `n` vertex indices and appends their fan `(v0, vi, vi+1)`; a face of fewer than three
+/// is read past and left in `out.short` (or is an error when loading is strict).
 fn read_face(v: &mut impl Values, n: i64, item: Scalar, out: &mut Out) -> Result<(), String> {
     if n < 3 {
-        return Err(format!("face has {n} vertices; a face needs at least 3"));
+        if out.options.strict {
+            return Err(format!("face has {n} vertices; a face needs at least 3"));
+        }
+        for _ in 0..n {
+            v.skip(item)?;
+        }
+        out.short = Some(n);
+        return Ok(());
     }
     let vertices = out.vertices;
     let mut index = || -> Result<u32, String> {
@@ -364,6 +397,10 @@ fn read_face(v: &mut impl Values, n: i64, item: Scalar, out: &mut Out) -> Result
         out.mesh.triangles.push([first, prev, next]);
         prev = next;
     }
+    if out.options.sources {
+        let n = (n - 2) as usize;
+        out.report.sources.extend(core::iter::repeat_n(Source::Face(out.face), n));
+    }
     Ok(())
 }
 
@@ -378,7 +415,9 @@ fn read_ascii(data: &[u8], name: &str, header: &Header, out: &mut Out) -> Result
             }
             let line = text.line;
             let here = |e: String| MeshError::at_line(name, line, format!("{} {i}: {e}", el.name));
+            out.face = i as u64;
             read_element(&mut text, el, out).map_err(here)?;
+            out.note_skipped(|| format!("face {i} (line {line})"));
             if let Some(extra) = text.token() {
                 let msg = format!("more values than the header declares (extra {:?})", show(extra));
                 return Err(here(msg));
@@ -499,10 +538,12 @@ fn read_binary(data: &[u8], name: &str, header: &Header, big_endian: bool, out: 
     for el in header.elements.iter().filter(|el| !el.properties.is_empty()) {
         for i in 0..el.count {
             let start = bin.pos;
+            out.face = i as u64;
             read_element(&mut bin, el, out).map_err(|e| {
                 let msg = format!("{} {i} of {} (starting at byte {start}): {e}", el.name, el.count);
                 MeshError::at_offset(name, bin.pos as u64, msg)
             })?;
+            out.note_skipped(|| format!("face {i} (byte {start})"));
         }
     }
     if bin.pos != data.len() {
@@ -580,8 +621,13 @@ impl Values for Binary<'_> {
 mod tests {
     use super::*;
 
+    /// The error of strict loading.
     fn err(text: &[u8]) -> String {
-        parse(text, "t.ply").unwrap_err().to_string()
+        parse(text, "t.ply", &LoadOptions::STRICT).unwrap_err().to_string()
+    }
+
+    fn load(text: &[u8]) -> Mesh {
+        parse(text, "t.ply", &LoadOptions::default()).unwrap().0
     }
 
     const HEAD: &str = "ply\nformat ascii 1.0\ncomment c\nelement vertex 4\nproperty float x\nproperty float y\n\
@@ -590,7 +636,7 @@ property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_he
     #[test]
     fn ascii_quad_fan() {
         let text = format!("{HEAD}0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
-        let m = parse(text.as_bytes(), "t.ply").unwrap();
+        let m = load(text.as_bytes());
         assert_eq!(m.positions[2], Vec3::new(1., 1., 0.));
         assert_eq!(m.triangles, [[0, 1, 2], [0, 2, 3]]);
     }
@@ -603,9 +649,43 @@ element edge 2\r\nproperty list ushort uint pair\r\nproperty char flag\r\n\
 element face 2\r\nproperty uint8 tag\r\nproperty list uint8 uint32 vertex_index\r\nproperty list uchar float w\r\n\
 end_header\r\n0.5 2 0.25 0.75 1 255 -3\r\n1 0 0 0 0\r\n2 1 3 4 0 7\r\n\r\n2 0 1 -1\r\n\t3 0 1 2 1\r\n\
 9 3 0 1 2 0\r\n9 3 2 1 0 3 1 2 3\r\n";
-        let m = parse(text.as_bytes(), "t.ply").unwrap();
+        let m = load(text.as_bytes());
         assert_eq!(m.positions, [Vec3::new(0.5, 1., -3.), Vec3::X, Vec3::new(2., 4., 7.)]);
         assert_eq!(m.triangles, [[0, 1, 2], [2, 1, 0]]);
+    }
+
+    #[test]
+    fn short_faces_are_skipped_and_counted() {
+        let options = LoadOptions { strict: false, sources: true };
+        let text =
+            format!("{}0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 1\n4 0 1 2 3\n0\n1 3\n", HEAD.replace("face 1", "face 4"));
+        let (m, report) = parse(text.as_bytes(), "t.ply", &options).unwrap();
+        assert_eq!(m.triangles, [[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(report.sources, [Source::Face(1), Source::Face(1)]);
+        assert_eq!(report.skipped, 3);
+        let first = report.first_skipped.unwrap();
+        assert_eq!((first.location.as_str(), first.what.as_str()), ("face 0 (line 15)", "a face with 2 vertices"));
+        // A skipped face's indices are still read (and checked for their type).
+        let bad = text.replace("1 3\n", "1 x\n");
+        let e = parse(bad.as_bytes(), "t.ply", &options).unwrap_err().to_string();
+        assert_eq!(e, "t.ply:18: face 3: not an integer: \"x\"");
+        // Binary: positioned by byte.
+        let mut bin = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+            .to_vec();
+        let body = bin.len();
+        for c in [0f32, 0., 0., 1., 0., 0., 0., 1., 0.] {
+            bin.extend(c.to_le_bytes());
+        }
+        for face in [&[0i32, 1][..], &[0, 1, 2]] {
+            bin.push(face.len() as u8);
+            face.iter().for_each(|i| bin.extend(i.to_le_bytes()));
+        }
+        let (m, report) = parse(&bin, "b.ply", &options).unwrap();
+        assert_eq!((m.triangles, report.sources), (std::vec![[0, 1, 2]], std::vec![Source::Face(1)]));
+        assert_eq!(report.first_skipped.unwrap().location, format!("face 0 (byte {})", body + 36));
+        let e = parse(&bin, "b.ply", &LoadOptions::STRICT).unwrap_err().to_string();
+        assert!(e.contains("face 0 of 2") && e.ends_with("face has 2 vertices; a face needs at least 3"), "{e}");
     }
 
     #[test]
@@ -689,7 +769,7 @@ element extra 1\nproperty list int32 float64 stuff\nend_header\n",
     #[test]
     fn binary_round_trip_every_type() {
         for be in [false, true] {
-            let m = parse(&binary_ply(be), "b.ply").unwrap();
+            let m = load(&binary_ply(be));
             assert_eq!(m.positions, [Vec3::new(0.5, 1.25, -2.), Vec3::X, Vec3::new(0., 2.5, 3.)]);
             assert_eq!(m.triangles, [[0, 1, 2], [2, 1, 0], [2, 0, 1]]);
         }
@@ -732,7 +812,7 @@ element extra 1\nproperty list int32 float64 stuff\nend_header\n",
     fn huge_counts_fail_fast() {
         for format in ["ascii", "binary_big_endian"] {
             let empty = format!("ply\nformat {format} 1.0\nelement junk 18446744073709551615\nend_header\n");
-            assert_eq!(parse(empty.as_bytes(), "t.ply").unwrap(), Mesh::default());
+            assert_eq!(load(empty.as_bytes()), Mesh::default());
             let cut = format!(
                 "ply\nformat {format} 1.0\nelement vertex 4000000000\nproperty int x\nproperty int y\n\
 property int z\nend_header\n"
