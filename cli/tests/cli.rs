@@ -132,3 +132,30 @@ fn bench_with_embree_needs_the_feature() {
         }
     }
 }
+
+/// An OBJ with edges written as 2-vertex faces, a polyline and a point loads by default with one
+/// warning line naming the count and the first location; `--strict` makes it today's error.
+#[test]
+fn short_faces_lines_and_points_warn_by_default_and_fail_under_strict() {
+    let obj = tmp("edges.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4\nl 1 2 3\np 4\nf 2 4 3\n").unwrap();
+    let rays = tmp("edges_rays.npy");
+    let run = |strict: bool| {
+        let mut cmd = bin();
+        cmd.args(["rays", "--scene", &obj.display().to_string(), "--out", &rays.display().to_string()]);
+        if strict {
+            cmd.arg("--strict");
+        }
+        cmd.output().unwrap()
+    };
+    let lenient = run(false);
+    let err = String::from_utf8_lossy(&lenient.stderr);
+    assert!(lenient.status.success(), "{err}");
+    let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(warnings[0].contains('3') && warnings[0].contains("line 6"), "{}", warnings[0]);
+    let strict = run(true);
+    let err = String::from_utf8_lossy(&strict.stderr);
+    assert!(!strict.status.success(), "{err}");
+    assert!(err.contains("face has 2 vertices; a face needs at least 3") && !err.contains("panicked"), "{err}");
+}
