@@ -38,3 +38,40 @@ impl TriangleBlock {
         core::array::from_fn(|vertex| core::array::from_fn(|axis| self.v[vertex][axis][lane]))
     }
 }
+
+/// The answers for the four lanes of a [`TriangleBlock`]: a mask of the lanes hit, and each hit
+/// lane's [`TriangleHit`](super::TriangleHit) fields.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlockHits {
+    /// Bit `i` set where lane `i` is hit.
+    pub mask: u32,
+    /// Ray parameter per lane (meaningful where `mask` is set).
+    pub t: [f32; BLOCK],
+    /// Barycentric weight of the second vertex per lane.
+    pub u: [f32; BLOCK],
+    /// Barycentric weight of the third vertex per lane.
+    pub v: [f32; BLOCK],
+}
+
+impl BlockHits {
+    /// No lane hit.
+    pub const NONE: BlockHits = BlockHits { mask: 0, t: [0.0; BLOCK], u: [0.0; BLOCK], v: [0.0; BLOCK] };
+
+    /// Sets `lane` to `hit` (or clears it).
+    #[inline(always)]
+    pub fn set(&mut self, lane: usize, hit: Option<super::TriangleHit>) {
+        match hit {
+            Some(h) => {
+                self.mask |= 1 << lane;
+                (self.t[lane], self.u[lane], self.v[lane]) = (h.t, h.u, h.v);
+            }
+            None => self.mask &= !(1 << lane),
+        }
+    }
+
+    /// Lane `lane`'s hit, if it has one.
+    #[inline(always)]
+    pub fn get(&self, lane: usize) -> Option<super::TriangleHit> {
+        (self.mask & (1 << lane) != 0).then(|| super::TriangleHit { t: self.t[lane], u: self.u[lane], v: self.v[lane] })
+    }
+}

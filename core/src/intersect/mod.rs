@@ -12,7 +12,7 @@ mod slab_pair;
 pub(crate) mod test_values;
 mod watertight;
 
-pub use block::{TriangleBlock, BLOCK};
+pub use block::{BlockHits, TriangleBlock, BLOCK};
 pub use context::{BoxConstants, KdRayContext, NoPair, RayContext, RELIABLE_LIMIT, SLACK_SCALE, SLACK_ULPS};
 pub use moller_trumbore::MollerTrumbore;
 pub use slab::{BoxHit, SlabRay, FAR_PAD};
@@ -54,15 +54,12 @@ pub trait TriangleTest: Copy + Default + Send + Sync + 'static {
     /// [`TriangleTest::intersect_in_place`] gives for it bit for bit; the default tests the lanes
     /// one by one, a test may do them at once.
     #[inline(always)]
-    fn intersect_block(
-        ray: &Self::PerRay,
-        block: &TriangleBlock,
-        tmin: f32,
-        tmax: f32,
-    ) -> [Option<TriangleHit>; BLOCK] {
-        core::array::from_fn(|lane| {
+    fn intersect_block(ray: &Self::PerRay, block: &TriangleBlock, tmin: f32, tmax: f32) -> BlockHits {
+        let mut out = BlockHits::NONE;
+        for lane in 0..BLOCK {
             let [a, b, c] = block.lane(lane);
-            Self::intersect_in_place(ray, [&a, &b, &c], tmin, tmax)
-        })
+            out.set(lane, Self::intersect_in_place(ray, [&a, &b, &c], tmin, tmax));
+        }
+        out
     }
 }

@@ -1,4 +1,4 @@
-use super::{TriangleBlock, TriangleHit, TriangleTest, BLOCK};
+use super::{BlockHits, TriangleBlock, TriangleHit, TriangleTest};
 use crate::Ray;
 use glam::{Vec3, Vec3A};
 
@@ -103,21 +103,25 @@ impl TriangleTest for Watertight {
     /// order, so every answer is [`Watertight::intersect_in_place`]'s bit for bit; a lane with a
     /// zero edge function takes the scalar test and its `f64` fallback.
     #[inline(always)]
-    fn intersect_block(r: &ShearedRay, block: &TriangleBlock, tmin: f32, tmax: f32) -> [Option<TriangleHit>; BLOCK] {
+    fn intersect_block(r: &ShearedRay, block: &TriangleBlock, tmin: f32, tmax: f32) -> BlockHits {
         #[cfg(target_arch = "x86_64")]
         return sse::intersect_block(r, block, tmin, tmax);
         #[cfg(not(target_arch = "x86_64"))]
-        return core::array::from_fn(|lane| {
-            let [a, b, c] = block.lane(lane);
-            Self::intersect_in_place(r, [&a, &b, &c], tmin, tmax)
-        });
+        {
+            let mut out = BlockHits::NONE;
+            for lane in 0..super::BLOCK {
+                let [a, b, c] = block.lane(lane);
+                out.set(lane, Self::intersect_in_place(r, [&a, &b, &c], tmin, tmax));
+            }
+            out
+        }
     }
 }
 
 /// The SSE path of [`Watertight::intersect_block`] (SSE2 is part of the x86_64 baseline).
 #[cfg(target_arch = "x86_64")]
 mod sse {
-    use super::{ShearedRay, TriangleBlock, TriangleHit, TriangleTest, Watertight, BLOCK};
+    use super::{BlockHits, ShearedRay, TriangleBlock, TriangleTest, Watertight};
     use core::arch::x86_64::{
         __m128, _mm_add_ps, _mm_and_ps, _mm_andnot_ps, _mm_cmpeq_ps, _mm_cmpgt_ps, _mm_cmplt_ps, _mm_cmpngt_ps,
         _mm_cmpnlt_ps, _mm_div_ps, _mm_loadu_ps, _mm_movemask_ps, _mm_mul_ps, _mm_or_ps, _mm_set1_ps, _mm_storeu_ps,
@@ -126,12 +130,7 @@ mod sse {
 
     #[inline(always)]
     #[allow(unused_unsafe)] // SSE2 intrinsics are safe to call from Rust 1.87 on; rust-version is older.
-    pub(super) fn intersect_block(
-        r: &ShearedRay,
-        block: &TriangleBlock,
-        tmin: f32,
-        tmax: f32,
-    ) -> [Option<TriangleHit>; BLOCK] {
+    pub(super) fn intersect_block(r: &ShearedRay, block: &TriangleBlock, tmin: f32, tmax: f32) -> BlockHits {
         let [kx, ky, kz] = r.k;
         let [ox, oy, oz] = r.origin;
         let [sx, sy, sz] = r.s;
@@ -186,17 +185,17 @@ mod sse {
                 _mm_movemask_ps(zero) as u32,
             )
         };
-        core::array::from_fn(|lane| {
-            if zero & (1 << lane) != 0 {
-                // A zero edge function: the scalar test, with its f64 recomputation.
-                let [a, b, c] = block.lane(lane);
-                Watertight::intersect_in_place(r, [&a, &b, &c], tmin, tmax)
-            } else if ok & (1 << lane) != 0 {
-                Some(TriangleHit { t: t[lane], u: u[lane], v: v[lane] })
-            } else {
-                None
-            }
-        })
+        let mut out = BlockHits { mask: ok & !zero, t, u, v };
+        // A zero edge function (rare): the scalar test, with its f64 recomputation. The hit lanes
+        // are left as a mask, so the caller branches on hits rather than on each lane.
+        let mut z = zero;
+        while z != 0 {
+            let lane = z.trailing_zeros() as usize;
+            let [a, b, c] = block.lane(lane);
+            out.set(lane, Watertight::intersect_in_place(r, [&a, &b, &c], tmin, tmax));
+            z &= z - 1;
+        }
+        out
     }
 }
 
@@ -338,10 +337,11 @@ mod tests {
                 .collect();
             let block = TriangleBlock::new(&tris);
             let got = Watertight::intersect_block(&r, &block, ray.tmin, ray.tmax);
-            for (lane, g) in got.iter().enumerate() {
+            for lane in 0..4 {
+                let g = got.get(lane);
                 let [a, b, c] = block.lane(lane);
                 let want = Watertight::intersect_in_place(&r, [&a, &b, &c], ray.tmin, ray.tmax);
-                assert!(same(*g, want), "lane {lane} of {tris:?}, {ray:?}: {g:?} != {want:?}");
+                assert!(same(g, want), "lane {lane} of {tris:?}, {ray:?}: {g:?} != {want:?}");
                 hits += usize::from(want.is_some());
                 if lane < tris.len() {
                     let (ax, ay) = (a[r.k[0]] - r.origin[0], a[r.k[1]] - r.origin[1]);

@@ -5,7 +5,7 @@
 use super::kernel::ChildKernel;
 use super::memory::WideMemory;
 use super::node::WideChild;
-use crate::intersect::{NoPair, RayContext, TriangleTest, BLOCK};
+use crate::intersect::{BlockHits, NoPair, RayContext, TriangleHit, TriangleTest, BLOCK};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
 use crate::traverse::{begin, QueryState, Step};
@@ -160,24 +160,43 @@ fn leaf<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKern
         } else {
             let tri = mem.wide_triangle(pos);
             let [a, b, c] = &*tri;
-            let mut hits = [None; BLOCK];
-            hits[0] = T::intersect_in_place(&per_ray, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit());
+            let mut hits = BlockHits::NONE;
+            hits.set(0, T::intersect_in_place(&per_ray, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit()));
             (hits, 1)
         };
-        for h in &hits[..n as usize] {
-            let prim = mem.prim(pos);
-            obs.primitive(prim);
-            if let Some(h) = *h {
+        let live = hits.mask & ((1 << n) - 1);
+        if O::ENABLED {
+            // Every triangle tested is an event, up to an any-hit query's answer.
+            for lane in 0..n as usize {
+                let prim = mem.prim(pos + lane as u32);
+                obs.primitive(prim);
+                if let Some(h) = hits.get(lane).filter(|_| live & (1 << lane) != 0) {
+                    if q.offer(h, prim) {
+                        obs.hit(prim, h.t);
+                        taken = true;
+                        if q.any {
+                            return true;
+                        }
+                    }
+                }
+            }
+        } else {
+            // The same offers, visiting only the lanes hit: a branch per hit, not per lane.
+            let mut m = live;
+            while m != 0 {
+                let lane = m.trailing_zeros() as usize;
+                let prim = mem.prim(pos + lane as u32);
+                let h = TriangleHit { t: hits.t[lane], u: hits.u[lane], v: hits.v[lane] };
                 if q.offer(h, prim) {
-                    obs.hit(prim, h.t);
                     taken = true;
                     if q.any {
                         return true;
                     }
                 }
+                m &= m - 1;
             }
-            pos += 1;
         }
+        pos += n;
     }
     taken
 }
