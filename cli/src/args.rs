@@ -1,76 +1,358 @@
-//! A small `--flag value` parser: the CLI needs no more. Also the mesh loading that `--strict`
+//! The command line's flags, declared with clap (derive), and the mesh loading that `--strict`
 //! and `--prim-map` shape, shared by the commands that take `--scene`.
+//!
+//! Usage errors (clap's, and the checks [`Failure::Usage`] carries) exit with status 2; failures
+//! while working exit with status 1.
 
+use clap::builder::PossibleValuesParser;
+use clap::{Parser, Subcommand};
 use raytrail::conformance::NamedScene;
 use raytrail::core::mesh::{write_sources_csv, LoadOptions, LoadReport};
-use std::collections::HashMap;
+use raytrail::core::method::Method;
+use raytrail::{Builder, BUILTIN_SCENE};
+use std::path::Path;
 
-/// The switch that makes mesh loading strict (`run`, `trace`, `rays`, `bench`): an element that is
-/// not a triangle or polygon (a face of fewer than three vertices, an OBJ line or point, a glTF
-/// line or point primitive) fails the load instead of being skipped with a warning.
+/// The switch that makes mesh loading strict (`run`, `trace`, `rays`, `bench`, `render`): an
+/// element that is not a triangle or polygon (a face of fewer than three vertices, an OBJ line or
+/// point, a glTF line or point primitive) fails the load instead of being skipped with a warning.
 pub const STRICT: &str = "strict";
 
-/// Flags given as `--name value` or bare `--name`.
-pub struct Args {
-    values: HashMap<String, Option<String>>,
+/// Why a command did not finish: a usage error (exit status 2) or a failure while working (1).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Failure {
+    /// The command line asks for something impossible: nothing was done.
+    Usage(String),
+    /// The work failed (a file that does not load, a write that fails, ...).
+    Run(String),
 }
 
-impl Args {
-    /// Parses `args`; `switches` are the flags that take no value.
-    pub fn parse(args: &[String], switches: &[&str]) -> Result<Args, String> {
-        let mut values = HashMap::new();
-        let mut it = args.iter();
-        while let Some(a) = it.next() {
-            let name =
-                a.strip_prefix("--").ok_or_else(|| format!("unexpected argument '{a}' (flags start with --)"))?;
-            if switches.contains(&name) {
-                values.insert(name.to_string(), None);
-            } else {
-                let v = it.next().ok_or_else(|| format!("--{name} needs a value"))?;
-                values.insert(name.to_string(), Some(v.clone()));
-            }
-        }
-        Ok(Args { values })
-    }
-
-    /// Rejects flags outside `known`.
-    pub fn only(&self, known: &[&str]) -> Result<(), String> {
-        match self.values.keys().find(|k| !known.contains(&k.as_str())) {
-            Some(k) => Err(format!(
-                "unknown flag --{k}; known: {}",
-                known.iter().map(|k| format!("--{k}")).collect::<Vec<_>>().join(" ")
-            )),
-            None => Ok(()),
+impl Failure {
+    /// The exit status of this failure.
+    pub fn code(&self) -> i32 {
+        match self {
+            Failure::Usage(_) => 2,
+            Failure::Run(_) => 1,
         }
     }
 
-    /// The value of `--name`, if given.
-    pub fn get(&self, name: &str) -> Option<&str> {
-        self.values.get(name).and_then(|v| v.as_deref())
-    }
-
-    /// Whether the switch `--name` was given.
-    pub fn has(&self, name: &str) -> bool {
-        self.values.contains_key(name)
-    }
-
-    /// The value of `--name` parsed, or `default`.
-    pub fn num<T: std::str::FromStr>(&self, name: &str, default: T) -> Result<T, String> {
-        match self.get(name) {
-            None => Ok(default),
-            Some(v) => v.parse().map_err(|_| format!("--{name}: '{v}' is not a valid number")),
+    /// The message.
+    pub fn message(&self) -> &str {
+        match self {
+            Failure::Usage(m) | Failure::Run(m) => m,
         }
     }
+}
 
-    /// The value of `--name`, required.
-    pub fn required(&self, name: &str) -> Result<&str, String> {
-        self.get(name).ok_or_else(|| format!("--{name} is required"))
+impl From<String> for Failure {
+    fn from(m: String) -> Self {
+        Failure::Run(m)
     }
+}
 
+impl From<&str> for Failure {
+    fn from(m: &str) -> Self {
+        Failure::Run(m.to_string())
+    }
+}
+
+/// What a command returns: its exit status when it finished (0, or 1 for a failed conformance
+/// check), or why it did not.
+pub type Outcome = Result<i32, Failure>;
+
+/// A usage error.
+pub fn usage<T>(m: impl Into<String>) -> Result<T, Failure> {
+    Err(Failure::Usage(m.into()))
+}
+
+const AFTER_HELP: &str = "\
+METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
+         kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree);
+         bvh4, bvh8, bvh4-naive (wide BVH)
+SCENES:  OBJ, PLY (ASCII or binary), OFF, STL (ASCII or binary), glTF 2.0 (.gltf, .glb), any of them
+         gzip-compressed; `builtin` is a generated sphereflake. Elements that are not triangles or
+         polygons (2-vertex faces, OBJ lines and points) are skipped with one warning line;
+         --strict makes them an error
+EXIT STATUS: 0 done; 1 a failure while working (or a failed conformance check); 2 a usage error";
+
+/// `raytrail`: ray-traversal methods for triangle scenes.
+#[derive(Parser, Debug)]
+#[command(
+    name = "raytrail",
+    version,
+    about = "raytrail: ray-traversal methods for triangle scenes",
+    long_about = "raytrail: ray-traversal methods for triangle scenes.\n\nWithout a subcommand, runs the main job \
+                  (`raytrail run`) with the flags given.",
+    after_help = AFTER_HELP,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
+pub struct Cli {
+    /// The subcommand; none is `run`.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// `run`'s flags, for `raytrail` without a subcommand.
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// The main job: every method timed and checked on one scene (the default command)
+    ///
+    /// Builds the BVH, derives layouts and hash tables, traces primary, shadow and diffuse rays
+    /// with every method on the CPU and (when wgpu finds an adapter) on the GPU, and prints
+    /// Mrays/s, work per ray, state size and the conformance verdict.
+    #[command(after_help = AFTER_HELP)]
+    Run(RunArgs),
+    /// Traces a NumPy ray file into a NumPy hit file
+    #[command(
+        long_about = "Traces a NumPy ray file (float32, shape (N, 8): origin xyz, tmin, dir xyz, tmax) into a hit \
+                      file (fields t <f4, prim <u4, u <f4, v <f4; a miss has t = inf, prim = 0xFFFFFFFF), hit i \
+                      for ray i.",
+        after_help = AFTER_HELP
+    )]
+    Trace(TraceArgs),
+    /// Writes primary rays framing the scene, for `trace`
+    #[command(
+        long_about = "Writes primary rays framing the scene (a NumPy file for `trace`). --order morton (the default) \
+                      writes them in Morton (Z-curve) order of their pixels, which traces faster; --order raster \
+                      writes them row by row, top-left first, so ray i is pixel (i % width, i / width). For Morton \
+                      order, the pixel of ray i is the i-th pixel in the Z-curve over the smallest power-of-two \
+                      square holding the image, pixels outside the image skipped.",
+        after_help = AFTER_HELP
+    )]
+    Rays(RaysArgs),
+    /// Times raytrail's methods and the peer libraries on the same rays
+    #[command(
+        long_about = "Times raytrail's methods and the peers (obvhs-bvh2, obvhs-cwbvh, bvh; each also as NAME+wt \
+                      with raytrail's watertight test; embree, own test only, in a binary built with `--features \
+                      embree`) on the same rays on the same thread pool; prints Mrays/s (median of N passes after a \
+                      warm-up), the ratio to the baseline, work per ray, build times, memory and hit agreement with \
+                      the stack method. Views: the camera outside the scene framing it, or inside it (low in its \
+                      box, looking along the long side, 90-degree field of view); `auto` adds the inside view where \
+                      it sees a room.",
+        after_help = AFTER_HELP
+    )]
+    Bench(crate::bench::options::BenchArgs),
+    /// Renders the scene to a PNG: normals, ambient occlusion, or a heat map of traversal work
+    ///
+    /// Primary rays in raster order through the outside or inside camera; the image shows the hit
+    /// triangles' normals, ambient occlusion, or a heat map of the traversal work per pixel (nodes
+    /// visited, or backtracking steps) of any --method, so that methods can be compared by eye.
+    #[command(after_help = AFTER_HELP)]
+    Render(RenderArgs),
+}
+
+/// The mesh loading flags.
+#[derive(clap::Args, Debug, Clone, Default, PartialEq, Eq)]
+pub struct LoadFlags {
+    /// Fail on mesh elements that are not triangles or polygons instead of skipping them
+    #[arg(long)]
+    pub strict: bool,
+}
+
+impl LoadFlags {
     /// The mesh loading policy of [`STRICT`].
     pub fn load_options(&self) -> LoadOptions {
-        LoadOptions { strict: self.has(STRICT), ..LoadOptions::default() }
+        LoadOptions { strict: self.strict, ..LoadOptions::default() }
     }
+}
+
+/// The BVH2 builders by command-line name.
+pub const BUILDERS: [&str; 2] = ["sah", "ploc"];
+
+/// The method names, for `--method`.
+pub fn method_names() -> PossibleValuesParser {
+    PossibleValuesParser::new(Method::ALL.map(Method::name))
+}
+
+/// The builder of a name that clap has checked.
+pub fn builder(name: &str) -> Builder {
+    Builder::from_name(name).unwrap_or_default()
+}
+
+/// The method of a name that clap has checked.
+pub fn method(name: &str) -> Method {
+    Method::from_name(name).expect("clap checks the method name")
+}
+
+/// `raytrail run`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct RunArgs {
+    /// Scene file, or `builtin`
+    #[arg(long, short = 's', value_name = "FILE", default_value = BUILTIN_SCENE)]
+    pub scene: String,
+    /// BVH2 builder
+    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    pub builder: String,
+    /// Primary image width
+    #[arg(long, short = 'W', default_value_t = 320, value_parser = clap::value_parser!(u32).range(1..))]
+    pub width: u32,
+    /// Primary image height
+    #[arg(long, short = 'H', default_value_t = 240, value_parser = clap::value_parser!(u32).range(1..))]
+    pub height: u32,
+    /// Timed passes per method (the median is reported)
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    pub passes: u32,
+    /// Worker threads [default: all]
+    #[arg(long, short = 'j', value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Rays per set checked for conformance (hits and node enumerations)
+    #[arg(long, default_value_t = 8192)]
+    pub check_rays: usize,
+    /// Leave the GPU out even when wgpu finds an adapter
+    #[arg(long)]
+    pub no_gpu: bool,
+    /// Most rays per ray set (each set holds one ray per pixel)
+    #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    #[command(flatten)]
+    pub load: LoadFlags,
+}
+
+/// `raytrail trace`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct TraceArgs {
+    /// Scene file, or `builtin`
+    #[arg(long, short = 's', value_name = "FILE")]
+    pub scene: String,
+    /// The NumPy ray file to trace
+    #[arg(long, value_name = "RAYS.npy")]
+    pub rays: String,
+    /// Traversal method
+    #[arg(long, short = 'm', default_value = "hash", value_parser = method_names(), hide_possible_values = true)]
+    pub method: String,
+    /// The NumPy hit file to write
+    #[arg(long, short = 'o', value_name = "HITS.npy")]
+    pub out: String,
+    /// Any-hit (occlusion) queries instead of closest-hit
+    #[arg(long)]
+    pub any: bool,
+    /// BVH2 builder
+    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    pub builder: String,
+    /// Möller-Trumbore triangle test instead of the watertight one
+    #[arg(long)]
+    pub moller_trumbore: bool,
+    /// Also write where in the mesh file each primitive id comes from (CSV: prim,file,<where>)
+    #[arg(long, value_name = "FILE.csv")]
+    pub prim_map: Option<String>,
+    /// Most rays the ray file may hold
+    #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    #[command(flatten)]
+    pub load: LoadFlags,
+}
+
+/// Ray orders of `raytrail rays`.
+pub const ORDERS: [&str; 2] = ["morton", "raster"];
+
+/// `raytrail rays`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct RaysArgs {
+    /// Scene file, or `builtin`
+    #[arg(long, short = 's', value_name = "FILE")]
+    pub scene: String,
+    /// The NumPy ray file to write
+    #[arg(long, short = 'o', value_name = "RAYS.npy")]
+    pub out: String,
+    /// Image width
+    #[arg(long, short = 'W', default_value_t = 320, value_parser = clap::value_parser!(u32).range(1..))]
+    pub width: u32,
+    /// Image height
+    #[arg(long, short = 'H', default_value_t = 240, value_parser = clap::value_parser!(u32).range(1..))]
+    pub height: u32,
+    /// Ray order: morton (Z-curve over the pixels, faster to trace) or raster (row by row, top-left
+    /// first: ray i is pixel (i % width, i / width))
+    #[arg(long, default_value = "morton", value_parser = ORDERS)]
+    pub order: String,
+    /// Most rays (width x height)
+    #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    #[command(flatten)]
+    pub load: LoadFlags,
+}
+
+/// What `raytrail render` draws.
+pub const RENDER_MODES: [&str; 4] = ["normals", "ao", "heat", "backtracks"];
+
+/// `raytrail render`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct RenderArgs {
+    /// Scene file, or `builtin`
+    #[arg(long, short = 's', value_name = "FILE", default_value = BUILTIN_SCENE)]
+    pub scene: String,
+    /// The PNG file to write
+    #[arg(long, short = 'o', value_name = "IMAGE.png")]
+    pub out: String,
+    /// What to draw: normals (shaded by the hit triangle's normal), ao (ambient occlusion), heat
+    /// (nodes visited per pixel by --method) or backtracks (backtracking steps per pixel by
+    /// --method); heat maps run on a log scale from dark blue (none) to red (the image's most)
+    #[arg(long, default_value = "normals", value_parser = RENDER_MODES)]
+    pub mode: String,
+    /// Image width
+    #[arg(long, short = 'W', default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    pub width: u32,
+    /// Image height
+    #[arg(long, short = 'H', default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    pub height: u32,
+    /// Camera: outside (framing the scene) or inside (low in its box, looking along the long side)
+    #[arg(long, default_value = "outside", value_parser = ["outside", "inside"])]
+    pub camera: String,
+    /// Traversal method
+    #[arg(long, short = 'm', default_value = "stack", value_parser = method_names(), hide_possible_values = true)]
+    pub method: String,
+    /// Backend for normals and ao: cpu, or gpu (wgpu, when it finds an adapter); heat maps run on
+    /// the CPU
+    #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
+    pub backend: String,
+    /// BVH2 builder
+    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    pub builder: String,
+    /// Ambient-occlusion rays per pixel (--mode ao)
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub ao_rays: u32,
+    /// Most pixels (width x height)
+    #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_PIXELS)]
+    pub max_pixels: u64,
+    #[command(flatten)]
+    pub load: LoadFlags,
+}
+
+/// Says on standard error when `--builder ploc` builds `scene` with the SAH builder instead
+/// (triangles collapsed to one point, which PLOC clusters in quadratic time).
+pub fn ploc_note(builder: Builder, scene: &raytrail::core::scene::Scene) {
+    if builder == Builder::Ploc {
+        if let Some(why) = raytrail::cpu::ploc::ploc_fallback(scene.triangles()) {
+            eprintln!("warning: --builder ploc: {why}");
+        }
+    }
+}
+
+/// Checks that `path` can be written as an output: its folder exists and it is not a folder.
+pub fn check_output(flag: &str, path: &str) -> Result<(), Failure> {
+    let p = Path::new(path);
+    if path.is_empty() {
+        return usage(format!("--{flag}: empty path"));
+    }
+    if p.is_dir() {
+        return usage(format!("--{flag}: cannot write {path}: it is a folder"));
+    }
+    let dir = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        return usage(format!("--{flag}: cannot write {path}: its folder {} does not exist", dir.display()));
+    }
+    Ok(())
+}
+
+/// Checks that the input file `path` exists (`builtin` is no file): a failure (exit status 1)
+/// found before any work.
+pub fn check_input(flag: &str, path: &str) -> Result<(), Failure> {
+    if path != BUILTIN_SCENE && !Path::new(path).is_file() {
+        return Err(Failure::Run(format!("--{flag}: {path}: no such file")));
+    }
+    Ok(())
 }
 
 /// Loads a scene (a mesh file or `builtin`) with `options`; returns the warning line to print
@@ -95,19 +377,21 @@ pub fn warn(warning: &Option<String>) {
 
 /// Writes the primitive-id map (`--prim-map`): CSV `prim,file,<where>`, one row per triangle.
 pub fn write_prim_map(out: &str, scene: &str, report: &LoadReport) -> Result<(), String> {
-    let fail = |e: std::io::Error| format!("cannot write {out}: {e}");
-    let file = std::fs::File::create(out).map_err(fail)?;
-    let mut w = std::io::BufWriter::new(file);
-    write_sources_csv(&mut w, scene, &report.sources).map_err(fail)?;
-    std::io::Write::flush(&mut w).map_err(fail)
+    raytrail_cli::write::write_atomically(out, |w| write_sources_csv(w, scene, &report.sources))
+        .map_err(|e| format!("cannot write {out}: {e}"))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn args(s: &str) -> Args {
-        Args::parse(&s.split_whitespace().map(str::to_string).collect::<Vec<_>>(), &[STRICT]).unwrap()
+    fn args(s: &str) -> LoadFlags {
+        let cli =
+            Cli::try_parse_from(format!("raytrail rays --scene a.obj --out r.npy {s}").split_whitespace()).unwrap();
+        match cli.command {
+            Some(Command::Rays(r)) => r.load,
+            other => panic!("{other:?}"),
+        }
     }
 
     /// A file in a scratch folder of this process.
@@ -122,9 +406,15 @@ mod tests {
     const OBJ: &[u8] = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nl 1 2 3\np 1\nf 1 2 3\n";
 
     #[test]
+    fn the_command_line_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+
+    #[test]
     fn strict_switch() {
-        assert!(!args("--scene a.obj").load_options().strict);
-        assert!(args("--scene a.obj --strict").load_options().strict);
+        assert!(!args("").load_options().strict);
+        assert!(args("--strict").load_options().strict);
         assert!(!args("--strict").load_options().sources);
     }
 

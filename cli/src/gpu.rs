@@ -50,6 +50,12 @@ impl Gpu {
         Ok(crate::median::median(&times))
     }
 
+    /// Traces `rays` once with `method` (`raytrail render --backend gpu`).
+    pub fn trace(&self, rays: &[Ray], method: Method, query: Query, hits: &mut [Hit]) -> Result<(), String> {
+        let opts = TraceOptions::new(method).query(query);
+        self.backend.trace(&self.scene, rays, &opts, hits).map(|_| ()).map_err(|e| e.to_string())
+    }
+
     /// Every method on `rays` on the GPU: against its reference there, and against the CPU.
     pub fn check(
         &self,

@@ -1,80 +1,58 @@
-//! The `raytrail` command line: the main job (no arguments), `trace`, `rays` and `bench`.
+//! The `raytrail` command line: the main job (no arguments), `trace`, `rays`, `bench` and
+//! `render`. Flags are declared with clap in [`args`]; usage errors exit with status 2, failures
+//! while working with status 1.
 
 mod args;
 mod bench;
 mod gpu;
+mod limits;
 mod median;
 mod progress;
+mod render;
 mod run;
 mod trace;
 
-const USAGE: &str = "\
-raytrail: ray-traversal methods for triangle scenes
-
-USAGE:
-  raytrail                      the main job on the built-in scene (same as `raytrail run`)
-  raytrail run [--scene FILE] [--builder sah|ploc] [--width W] [--height H] [--passes N]
-               [--threads N] [--check-rays N] [--no-gpu] [--strict]
-      builds the BVH, derives layouts and hash tables, traces primary, shadow and diffuse rays
-      with every method on the CPU and, when wgpu finds an adapter, on the GPU, and prints
-      Mrays/s, work per ray, state size and the conformance verdict
-  raytrail trace --scene FILE --rays RAYS.npy --method NAME --out HITS.npy [--any]
-               [--builder sah|ploc] [--moller-trumbore] [--strict] [--prim-map FILE.csv]
-      traces a NumPy ray file (float32, shape (N, 8): origin xyz, tmin, dir xyz, tmax) into a hit
-      file (fields t <f4, prim <u4, u <f4, v <f4; a miss has t = inf, prim = 0xFFFFFFFF);
-      --prim-map writes where in the mesh file each primitive id comes from
-  raytrail rays --scene FILE --out RAYS.npy [--width W] [--height H] [--strict]
-      writes primary rays (Morton order) framing the scene, for `trace`
-  raytrail bench [--scene FILE[,FILE...]] [--rays primary,shadow,diffuse,ao] [--width W] [--height H]
-               [--passes N] [--threads N[,N...]] [--methods NAME,...|all|none] [--peers NAME,...|all|none]
-               [--baseline NAME] [--builder sah|ploc] [--ao-rays N] [--view outside|inside|both|auto]
-               [--json FILE] [--plot FILE.svg] [--strict]
-      times raytrail's methods and the peers (obvhs-bvh2, obvhs-cwbvh, bvh; each also as NAME+wt with
-      raytrail's watertight test; embree, own test only, in a binary built with `--features embree`)
-      on the same rays on the same thread pool; prints Mrays/s (median of N passes, default 5, after
-      a warm-up), the ratio to the baseline (default obvhs-bvh2), work per ray, build times, memory
-      and hit agreement with the stack method. Views: the camera outside the scene framing it, or
-      inside it (low in its box, looking along the long side, 90-degree field of view); `auto` adds
-      the inside view where it sees a room. Defaults: 512 x 512 primary rays, 4 ambient-occlusion
-      rays per hit, 1 thread and all threads, every method and peer, --view auto
-
-METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
-         kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree);
-         bvh4, bvh8, bvh4-naive (wide BVH)
-SCENES:  OBJ, PLY (ASCII or binary), OFF, STL (ASCII or binary), glTF 2.0 (.gltf, .glb), any of them
-         gzip-compressed; `builtin` is a generated sphereflake. Elements that are not triangles or
-         polygons (2-vertex faces, OBJ lines and points) are skipped with one warning line;
-         --strict makes them an error";
+use args::{Cli, Command};
+use clap::Parser;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    // `--help` anywhere (`raytrail bench --help`) prints the usage rather than a parse error.
-    if args.iter().any(|a| a == "-h" || a == "--help") {
-        println!("{USAGE}");
-        return;
-    }
-    let (cmd, rest) = match args.first().map(String::as_str) {
-        None => ("run", &args[..]),
-        Some("-h" | "--help" | "help") => {
-            println!("{USAGE}");
-            return;
-        }
-        Some(c) if c.starts_with("--") => ("run", &args[..]),
-        Some(c) => (c, &args[1..]),
-    };
-    let result = match cmd {
-        "run" => run::main(rest),
-        "trace" => trace::main(rest),
-        "rays" => trace::rays_main(rest),
-        "bench" => bench::main(rest),
-        other => Err(format!("unknown command '{other}'\n\n{USAGE}")),
+    restore_sigpipe();
+    let raw: Vec<String> = std::env::args_os().map(|a| a.to_string_lossy().into_owned()).collect();
+    // Usage errors exit with status 2; `--help` and `--version` print and exit with 0.
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => run::main(cli.run),
+        Some(Command::Run(a)) => run::main(a),
+        Some(Command::Trace(a)) => trace::main(a),
+        Some(Command::Rays(a)) => trace::rays_main(a),
+        // The report records the command as given.
+        Some(Command::Bench(a)) => bench::main(a, &raw[2.min(raw.len())..]),
+        Some(Command::Render(a)) => render::main(a),
     };
     match result {
         Ok(0) => {}
         Ok(code) => std::process::exit(code),
         Err(e) => {
-            eprintln!("error: {e}");
-            std::process::exit(2);
+            eprintln!("error: {}", e.message());
+            std::process::exit(e.code());
         }
+    }
+}
+
+/// Signal dispositions of a command-line tool.
+///
+/// Rust ignores SIGPIPE, so that printing to a closed pipe (`raytrail --help | head -3`) is an
+/// error, and `println!` panics on it. A command-line tool should do what the others do: end
+/// quietly. Restoring the default action makes the process end on the signal.
+///
+/// SIGXFSZ (a write beyond the file size limit, `ulimit -f`) would kill the process in the middle
+/// of a write, leaving its temporary file behind; ignored, the write fails with an error instead,
+/// and the atomic write removes the temporary file and keeps the previous output.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: setting signal actions at the start of main, before any other thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
 }

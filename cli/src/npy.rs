@@ -241,7 +241,7 @@ pub fn read_rays_from(mut reader: impl Read) -> Result<Vec<Ray>, NpyError> {
 }
 
 /// Writes `rays` to `path` as a little-endian float32 `.npy` array of shape `(N, 8)`, replacing
-/// any existing file.
+/// any existing file only once the new one is complete.
 pub fn write_rays(path: impl AsRef<Path>, rays: &[Ray]) -> Result<(), NpyError> {
     let path = path.as_ref();
     write_file(path, |w| write_rays_impl(w, rays))
@@ -270,7 +270,7 @@ pub fn read_hits_from(mut reader: impl Read) -> Result<Vec<Hit>, NpyError> {
 }
 
 /// Writes `hits` to `path` as a `.npy` structured array of shape `(N,)` with the dtype
-/// [`HIT_DESCR`] (little-endian), replacing any existing file. Misses are written as they are
+/// [`HIT_DESCR`] (little-endian), replacing any existing file only once the new one is complete. Misses are written as they are
 /// ([`Hit::MISS`]: `t = +inf`, `prim = 0xFFFFFFFF`).
 pub fn write_hits(path: impl AsRef<Path>, hits: &[Hit]) -> Result<(), NpyError> {
     let path = path.as_ref();
@@ -373,13 +373,10 @@ fn write_hits_impl(w: &mut impl Write, hits: &[Hit]) -> io::Result<()> {
     })
 }
 
-/// Creates `path`, runs `body` on a buffered writer, and flushes, so that a failed flush is
-/// reported rather than lost in a drop.
+/// Writes `path` atomically ([`crate::write::write_atomically`]): a failed write leaves any
+/// previous file untouched.
 fn write_file(path: &Path, body: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>) -> Result<(), NpyError> {
-    let io_err = |e| NpyError::new(path, NpyErrorKind::Io(e));
-    let mut w = BufWriter::new(File::create(path).map_err(io_err)?);
-    body(&mut w).map_err(io_err)?;
-    w.flush().map_err(io_err)
+    crate::write::write_atomically(path, body).map_err(|e| NpyError::new(path, NpyErrorKind::Io(e)))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -581,6 +578,8 @@ fn read_records<T>(
         if got < want {
             return Err(NpyErrorKind::Truncated { part: "data", expected: total, found: read });
         }
+        // Fallible: a file of real data larger than the memory is an error, not an abort.
+        out.try_reserve(want / size).map_err(|_| NpyErrorKind::TooLarge { shape: vec![count] })?;
         out.extend(buf[..want].chunks_exact(size).map(&mut decode));
         remaining -= (want / size) as u64;
     }

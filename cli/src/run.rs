@@ -1,7 +1,8 @@
 //! The main job: build, prepare, trace primary, shadow and diffuse rays with every method, and
 //! report speed, work per ray, state size, hash-table figures and the conformance verdict.
 
-use crate::args::{load_scene, warn, Args, STRICT};
+use crate::args::{builder, check_input, load_scene, warn, Outcome, RunArgs};
+use crate::limits::check_image;
 use crate::median::median;
 use crate::progress::{timed, Progress};
 use raytrail::conformance::check::{check_ray_set, Context, Mismatch};
@@ -13,10 +14,8 @@ use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::wide::WideStats;
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
-use raytrail::{Builder, BUILTIN_SCENE};
+use raytrail::Builder;
 use std::sync::Arc;
-
-const FLAGS: &[&str] = &["scene", "builder", "width", "height", "passes", "threads", "check-rays", "no-gpu", STRICT];
 
 /// One method's figures on a ray set: median seconds and counters.
 type Row = (Method, f64, Counters);
@@ -37,23 +36,25 @@ struct RaySetRun {
     rays: Vec<Ray>,
 }
 
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let a = Args::parse(args, &["no-gpu", STRICT])?;
-    a.only(FLAGS)?;
-    let scene_arg = a.get("scene").unwrap_or(BUILTIN_SCENE);
-    let builder = Builder::from_name(a.get("builder").unwrap_or("sah"))?;
-    let (width, height) = (a.num("width", 320u32)?, a.num("height", 240u32)?);
-    let passes = a.num("passes", 5usize)?.max(1);
-    let check_rays = a.num("check-rays", 8192usize)?;
-    let backend = match a.get("threads") {
-        Some(_) => CpuBackend::with_threads(a.num("threads", 1usize)?).map_err(|e| e.to_string())?,
+pub fn main(a: RunArgs) -> Outcome {
+    let scene_arg = a.scene.as_str();
+    let builder = builder(&a.builder);
+    let (width, height) = (a.width, a.height);
+    let passes = a.passes as usize;
+    let check_rays = a.check_rays;
+    // Rays and hits of the three sets, held at once.
+    check_image(width, height, "rays per set", "max-rays", a.max_rays, 3 * 48)?;
+    check_input("scene", scene_arg)?;
+    let backend = match a.threads {
+        Some(n) => CpuBackend::with_threads(n as usize).map_err(|e| e.to_string())?,
         None => CpuBackend::new(),
     };
 
-    let (loaded, _) = timed(&format!("loading {scene_arg}"), || load_scene(scene_arg, &a.load_options()));
+    let (loaded, _) = timed(&format!("loading {scene_arg}"), || load_scene(scene_arg, &a.load.load_options()));
     let (named, _, warning) = loaded?;
     warn(&warning);
     let scene = &named.scene;
+    crate::args::ploc_note(builder, scene);
     let (bvh, build_s) =
         timed(&format!("building the BVH2 ({}, {} triangles)", builder.name(), scene.triangles().len()), || {
             builder.build(scene)
@@ -65,7 +66,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     print_scene(&named.name, builder, build_s, &prepared);
 
     let cpu = backend.prepare(prepared.clone()).map_err(|e| e.to_string())?;
-    let gpu = if a.has("no-gpu") { Err("--no-gpu".to_string()) } else { crate::gpu::Gpu::open(prepared.clone()) };
+    let gpu = if a.no_gpu { Err("--no-gpu".to_string()) } else { crate::gpu::Gpu::open(prepared.clone()) };
     match &gpu {
         Ok(g) => println!("  GPU: {}", g.describe()),
         Err(why) => println!("  GPU: skipped ({why}); the CPU figures follow"),

@@ -1,64 +1,103 @@
 //! `raytrail trace` and `raytrail rays`: NumPy files in and out.
 
-use crate::args::{load_scene, warn, write_prim_map, Args, STRICT};
+use crate::args::{builder, check_input, check_output, load_scene, method, warn, write_prim_map, Outcome};
+use crate::args::{RaysArgs, TraceArgs};
+use crate::limits::{check_count, check_image, try_vec};
 use crate::progress::timed;
-use raytrail::conformance::rays::primary;
+use raytrail::conformance::rays::{primary_from, Camera};
 use raytrail::core::mesh::LoadOptions;
-use raytrail::core::method::{Method, Query};
+use raytrail::core::method::Query;
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::{Trace, TraceOptions, TriangleTestKind};
-use raytrail::core::Hit;
+use raytrail::core::{Hit, Ray};
 use raytrail::cpu::CpuBackend;
-use raytrail::Builder;
 use raytrail_cli::npy;
 use std::sync::Arc;
 
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let a = Args::parse(args, &["any", "moller-trumbore", STRICT])?;
-    a.only(&["scene", "rays", "method", "out", "any", "builder", "moller-trumbore", STRICT, "prim-map"])?;
-    let method_name = a.get("method").unwrap_or("hash");
-    let method = Method::from_name(method_name).ok_or_else(|| {
-        format!("unknown method '{method_name}' (known: {})", Method::ALL.map(Method::name).join(", "))
-    })?;
-    let builder = Builder::from_name(a.get("builder").unwrap_or("sah"))?;
-    let scene_path = a.required("scene")?;
-    let prim_map = a.get("prim-map");
-    let options = LoadOptions { sources: prim_map.is_some(), ..a.load_options() };
+/// Bytes a traced ray takes: the ray and its hit.
+const RAY_AND_HIT_BYTES: u64 = (std::mem::size_of::<Ray>() + std::mem::size_of::<Hit>()) as u64;
+
+pub fn main(a: TraceArgs) -> Outcome {
+    let method = method(&a.method);
+    let builder = builder(&a.builder);
+    // Every output location and input file is checked before any work.
+    check_output("out", &a.out)?;
+    if let Some(map) = &a.prim_map {
+        check_output("prim-map", map)?;
+    }
+    check_input("rays", &a.rays)?;
+    check_input("scene", &a.scene)?;
+    let rays = npy::read_rays(&a.rays).map_err(|e| e.to_string())?;
+    check_count("rays", rays.len() as u64, "max-rays", a.max_rays, RAY_AND_HIT_BYTES)?;
+    let scene_path = a.scene.as_str();
+    let options = LoadOptions { sources: a.prim_map.is_some(), ..a.load.load_options() };
     let (named, report, warning) = load_scene(scene_path, &options)?;
     warn(&warning);
-    if let Some(map) = prim_map {
+    if let Some(map) = &a.prim_map {
         if report.sources.len() != named.scene.triangles().len() {
-            return Err(format!("--prim-map: {scene_path} is not a mesh file: there is no source to map to"));
+            return Err(format!("--prim-map: {scene_path} is not a mesh file: there is no source to map to").into());
         }
         write_prim_map(map, scene_path, &report)?;
     }
-    let rays_path = a.required("rays")?;
-    let out = a.required("out")?;
-    let rays = npy::read_rays(rays_path).map_err(|e| e.to_string())?;
+    crate::args::ploc_note(builder, &named.scene);
     let (bvh, _) = timed("building the BVH2", || builder.build(&named.scene));
     let prepared =
         PreparedScene::new(&named.scene, bvh.map_err(|e| e.to_string())?, &[method]).map_err(|e| e.to_string())?;
     let backend = CpuBackend::new();
     let scene = backend.prepare(Arc::new(prepared)).map_err(|e| e.to_string())?;
-    let opts = TraceOptions::new(method).query(if a.has("any") { Query::Any } else { Query::Closest }).triangle_test(
-        if a.has("moller-trumbore") { TriangleTestKind::MollerTrumbore } else { TriangleTestKind::Watertight },
-    );
-    let mut hits = vec![Hit::MISS; rays.len()];
+    let opts = TraceOptions::new(method)
+        .query(if a.any { Query::Any } else { Query::Closest })
+        .triangle_test(if a.moller_trumbore { TriangleTestKind::MollerTrumbore } else { TriangleTestKind::Watertight });
+    let mut hits = try_vec(rays.len(), Hit::MISS, "hits")?;
     let report = backend.trace(&scene, &rays, &opts, &mut hits).map_err(|e| e.to_string())?;
+    let out = &a.out;
     npy::write_hits(out, &hits).map_err(|e| e.to_string())?;
     let n_hit = hits.iter().filter(|h| h.is_hit()).count();
     println!("{} rays, {} hits, {:.2} Mrays/s ({method}), written to {out}", rays.len(), n_hit, report.mrays_per_s());
     Ok(0)
 }
 
-pub fn rays_main(args: &[String]) -> Result<i32, String> {
-    let a = Args::parse(args, &[STRICT])?;
-    a.only(&["scene", "out", "width", "height", STRICT])?;
-    let (named, _, warning) = load_scene(a.required("scene")?, &a.load_options())?;
+/// Primary rays of `camera` through the pixel centers of a `width` x `height` image in raster
+/// order: row by row from the top, each row left to right, so ray `i` is pixel
+/// `(i % width, i / width)`.
+pub fn raster_rays(camera: &Camera, width: u32, height: u32) -> Vec<Ray> {
+    (0..height)
+        .flat_map(|y| (0..width).map(move |x| camera.ray(x as f32 + 0.5, y as f32 + 0.5, width, height)))
+        .collect()
+}
+
+pub fn rays_main(a: RaysArgs) -> Outcome {
+    check_output("out", &a.out)?;
+    // The rays, and the pixel list Morton order sorts.
+    check_image(a.width, a.height, "rays", "max-rays", a.max_rays, std::mem::size_of::<Ray>() as u64 + 8)?;
+    check_input("scene", &a.scene)?;
+    let (named, _, warning) = load_scene(&a.scene, &a.load.load_options())?;
     warn(&warning);
-    let rays = primary(&named.scene, a.num("width", 320u32)?, a.num("height", 240u32)?);
-    let out = a.required("out")?;
+    let camera = Camera::framing(named.scene.bounds());
+    let rays = if a.order == "raster" {
+        raster_rays(&camera, a.width, a.height)
+    } else {
+        primary_from(&camera, a.width, a.height)
+    };
+    let out = &a.out;
     npy::write_rays(out, &rays).map_err(|e| e.to_string())?;
-    println!("{} primary rays written to {out}", rays.len());
+    println!("{} primary rays ({} order) written to {out}", rays.len(), a.order);
     Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use raytrail::conformance::rays::morton_order;
+
+    #[test]
+    fn raster_order_is_morton_order_reordered() {
+        let camera = Camera::framing(raytrail::core::Aabb::new(glam::Vec3::ZERO, glam::Vec3::ONE));
+        let (w, h) = (7, 5);
+        let raster = raster_rays(&camera, w, h);
+        let morton = primary_from(&camera, w, h);
+        for (i, (x, y)) in morton_order(w, h).into_iter().enumerate() {
+            assert_eq!(raster[(y * w + x) as usize], morton[i]);
+        }
+    }
 }

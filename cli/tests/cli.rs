@@ -66,37 +66,45 @@ fn rays_then_trace_matches_the_library() {
     }
 }
 
+/// Bad input is an error, not a panic: usage errors exit with status 2, failures while working
+/// (a file that does not load) with status 1.
 #[test]
 fn bad_input_is_an_error_not_a_panic() {
     let bad = tmp("bad.npy");
     std::fs::write(&bad, b"not a numpy file").unwrap();
-    let cases: Vec<Vec<String>> = vec![
-        vec![
-            "trace".into(),
-            "--scene".into(),
-            "builtin".into(),
-            "--rays".into(),
-            bad.display().to_string(),
-            "--out".into(),
-            "x.npy".into(),
-        ],
-        vec![
-            "trace".into(),
-            "--scene".into(),
-            "/nonexistent.obj".into(),
-            "--rays".into(),
-            "r.npy".into(),
-            "--out".into(),
-            "x".into(),
-        ],
-        vec!["trace".into(), "--scene".into(), "builtin".into(), "--method".into(), "nope".into()],
-        vec!["run".into(), "--width".into(), "many".into()],
-        vec!["frobnicate".into()],
+    let cases: Vec<(i32, Vec<String>)> = vec![
+        (
+            1,
+            vec![
+                "trace".into(),
+                "--scene".into(),
+                "builtin".into(),
+                "--rays".into(),
+                bad.display().to_string(),
+                "--out".into(),
+                "x.npy".into(),
+            ],
+        ),
+        (
+            1,
+            vec![
+                "trace".into(),
+                "--scene".into(),
+                "/nonexistent.obj".into(),
+                "--rays".into(),
+                "r.npy".into(),
+                "--out".into(),
+                "x".into(),
+            ],
+        ),
+        (2, vec!["trace".into(), "--scene".into(), "builtin".into(), "--method".into(), "nope".into()]),
+        (2, vec!["run".into(), "--width".into(), "many".into()]),
+        (2, vec!["frobnicate".into()]),
     ];
-    for args in cases {
+    for (code, args) in cases {
         let out = bin().args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
         assert!(err.contains("error:") && !err.contains("panicked"), "{args:?}: {err}");
     }
 }

@@ -27,12 +27,12 @@
 //! that the reinsertion stack is sized from the tree's actual depth.
 //!
 //! Coincident triangles: PLOC merges only mutual nearest neighbours, and among primitives whose
-//! boxes tie (the same triangle many times, or triangles whose centres share one cell of obvhs's
-//! Morton grid) it merges about one pair per pass, so a run of `k` of them takes `k` passes over
-//! the run: 10,000 copies of one triangle took 2.7 s, 30,000 took 22 s, against milliseconds for
-//! the SAH builder. obvhs offers no way around it, so [`build_ploc`] falls back: when more than
-//! [`MAX_COINCIDENT`] primitives share one Morton cell ([`coincident_fallback`] says so, for
-//! callers to print), the whole tree is built by [`SahBuilder`] instead.
+//! boxes tie it merges about one pair per pass: 10,000 copies of one triangle took 2.7 s, 30,000
+//! took 22 s, against milliseconds for the SAH builder. Fixed around obvhs, without falling back:
+//! PLOC clusters boxes grown by tiny pseudo-random margins that break the ties ([`ploc_boxes`]);
+//! the tree's boxes are recomputed from the triangles as always. Margins cannot separate
+//! triangles collapsed to one point: where more than [`MAX_TIED`] boxes stay identical, the tree is
+//! built by [`SahBuilder`] instead ([`ploc_fallback`] gives the message).
 //!
 //! The conversion:
 //! - recomputes every box bottom-up from the triangles (leaf: union of its triangles' boxes,
@@ -42,6 +42,7 @@
 //! - hands the result to [`Bvh2::from_nodes`], which renumbers it into canonical pre-order and
 //!   validates it.
 
+use glam::Vec3;
 use obvhs::bvh2::leaf_collapser::collapse;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::ploc::PlocBuilder;
@@ -49,7 +50,6 @@ use obvhs::BvhBuildParams;
 use raytrail_core::bvh2::{Bvh2, Bvh2Node, NodeKind, NodeRef, SahBuilder, SahConfig};
 use raytrail_core::geometry::Triangle;
 use raytrail_core::{Aabb, Error};
-use glam::Vec3;
 use std::collections::HashMap;
 
 /// The deepest tree 64-bit keys allow (root at depth 0).
@@ -59,49 +59,6 @@ pub const MAX_KEY_DEPTH: u32 = 63;
 /// rarely forced to end a branch at the cap with an oversized leaf.
 const REBUILD_SLACK: u32 = 4;
 
-/// The most primitives that may share one cell of the Morton grid before [`build_ploc`] falls
-/// back to [`SahBuilder`]: a run of that many costs PLOC about a hundredth of a second.
-pub const MAX_COINCIDENT: usize = 1024;
-
-/// Bits per axis of the Morton grid of obvhs's 64-bit codes.
-const MORTON_BITS: u32 = 21;
-
-/// The most primitives whose box centres share one cell of obvhs's Morton grid (the union of the
-/// boxes cut into 2^21 steps per axis, as obvhs scales its codes), in O(n log n).
-pub fn largest_coincident_group(triangles: &[Triangle]) -> usize {
-    let boxes: Vec<Aabb> = triangles.iter().map(Triangle::bounds).collect();
-    let bounds = boxes.iter().fold(Aabb::EMPTY, |b, &x| b.union(x));
-    let centres: Vec<Vec3> = boxes.iter().map(Aabb::center).collect();
-    drop(boxes);
-    let extent = bounds.extent();
-    let steps = (1u32 << MORTON_BITS) as f32;
-    let cell = |c: Vec3, axis: usize| -> u64 {
-        let e = extent[axis];
-        if e > 0.0 && e.is_finite() {
-            (((c[axis] - bounds.min[axis]) / e * steps) as u64).min((1 << MORTON_BITS) - 1)
-        } else {
-            0
-        }
-    };
-    let mut keys: Vec<u64> = centres
-        .iter()
-        .map(|&c| cell(c, 0) | (cell(c, 1) << MORTON_BITS) | (cell(c, 2) << (2 * MORTON_BITS)))
-        .collect();
-    keys.sort_unstable();
-    keys.chunk_by(|a, b| a == b).map(<[u64]>::len).max().unwrap_or(0)
-}
-
-/// Why [`build_ploc`] builds `triangles` with [`SahBuilder`] instead of PLOC, if it does: more
-/// than [`MAX_COINCIDENT`] of them share one Morton cell.
-pub fn coincident_fallback(triangles: &[Triangle]) -> Option<String> {
-    let group = largest_coincident_group(triangles);
-    (group > MAX_COINCIDENT).then(|| {
-        format!(
-            "{group} triangles share one position (coincident or nearly so); PLOC would take time quadratic              in that number, so the SAH builder builds this tree instead"
-        )
-    })
-}
-
 /// The obvhs settings used: `medium_build`, pre-splits off (see the module documentation).
 fn obvhs_params() -> BvhBuildParams {
     BvhBuildParams { pre_split: false, ..BvhBuildParams::medium_build() }
@@ -110,8 +67,9 @@ fn obvhs_params() -> BvhBuildParams {
 /// Builds the canonical tree over `triangles` (primitive id = triangle index) with obvhs's PLOC
 /// builder and reinsertion optimizer, with depth at most `max_depth` (values above 63 mean 63).
 ///
-/// Where more than [`MAX_COINCIDENT`] triangles share a position, PLOC would take quadratic time:
-/// the tree is built by [`SahBuilder`] instead ([`coincident_fallback`] gives the message).
+/// Coincident and nearly coincident triangles build in time comparable to well-spread ones: see
+/// [`ploc_boxes`]; more than [`MAX_TIED`] triangles collapsed to one point are built by
+/// [`SahBuilder`] ([`ploc_fallback`]).
 ///
 /// Where the obvhs tree is deeper than `max_depth`, the offending subtrees are rebuilt with
 /// [`SahBuilder`] capped to the levels left below them. The subtrees chosen are the deepest ones
@@ -136,10 +94,11 @@ pub fn build_ploc(triangles: &[Triangle], max_depth: u32) -> Result<Bvh2, Error>
         }
     }
     let cap = max_depth.min(MAX_KEY_DEPTH);
-    if largest_coincident_group(triangles) > MAX_COINCIDENT {
+    let boxes = ploc_boxes(triangles);
+    if fallback_reason(largest_tie(&boxes)).is_some() {
         return SahBuilder::new(SahConfig { max_depth: cap, ..SahConfig::default() }).build(triangles);
     }
-    let built = build_obvhs(triangles);
+    let built = build_obvhs_on(boxes);
     let tree = Imported::new(&built, triangles)?;
     let rebuild_at = tree.subtrees_to_rebuild(cap);
     let mut rebuilt = HashMap::with_capacity(rebuild_at.len());
@@ -153,18 +112,83 @@ pub fn build_ploc(triangles: &[Triangle], max_depth: u32) -> Result<Bvh2, Error>
     Bvh2::from_nodes(&nodes, 0, prim_order)
 }
 
-/// Runs obvhs: PLOC, reinsertion, leaf collapse, reinsertion.
-fn build_obvhs(triangles: &[Triangle]) -> obvhs::bvh2::Bvh2 {
-    let p = obvhs_params();
-    let boxes: Vec<obvhs::aabb::Aabb> = triangles
+/// A 64-bit mix (SplitMix64's finaliser).
+fn mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The boxes PLOC clusters: each triangle's box grown about its centre by a pseudo-random margin
+/// of at most 2^-10 of its largest side (or of 2^-20 of its largest coordinate, for a triangle
+/// collapsed to a point).
+///
+/// PLOC merges mutual nearest neighbours only. Where neighbouring boxes are equal or nearly so
+/// (coincident triangles; a stack of equal triangles so close that the areas of their unions
+/// round to the same float), the distances tie, every node picks the same side, and a pass merges about one pair:
+/// PLOC then takes as many passes as there are triangles (10,000 copies of one triangle: 2.7 s;
+/// 30,000: 22 s; a stack of 30,000 spaced 1e-5 apart: 7 s). The margins break the ties at random,
+/// so that a constant share of the nodes pairs up in each pass, and barely move the distances of
+/// boxes that differ. The clustering is all they affect: the centres, hence the Morton order,
+/// are unchanged, and [`Imported::new`] recomputes every box from the triangles.
+fn ploc_boxes(triangles: &[Triangle]) -> Vec<obvhs::aabb::Aabb> {
+    triangles
         .iter()
-        .map(|t| {
+        .enumerate()
+        .map(|(i, t)| {
             let b = t.bounds();
-            obvhs::aabb::Aabb { min: b.min.into(), max: b.max.into() }
+            let r = (mix(i as u64 ^ 0x9E37_79B9_7F4A_7C15) >> 40) as f32 * (1.0 / (1u32 << 24) as f32);
+            let magnitude = b.min.abs().max(b.max.abs()).max_element();
+            let size = (b.extent().max_element() * (1.0 / 1024.0)).max(magnitude * (1.0 / (1u32 << 20) as f32));
+            let pad = Vec3::splat(r * size);
+            obvhs::aabb::Aabb { min: (b.min - pad).into(), max: (b.max + pad).into() }
+        })
+        .collect()
+}
+
+/// The most triangles whose [`ploc_boxes`] may be identical before [`build_ploc`] falls back to
+/// [`SahBuilder`]: margins cannot break ties between triangles collapsed to one point (no margin
+/// at the origin, a few float steps elsewhere), and a tie of `k` boxes costs PLOC about `k`
+/// passes.
+pub const MAX_TIED: usize = 256;
+
+/// The largest number of identical boxes among `boxes`, in O(n log n).
+fn largest_tie(boxes: &[obvhs::aabb::Aabb]) -> usize {
+    let mut keys: Vec<[u32; 6]> = boxes
+        .iter()
+        .map(|b| {
+            let (lo, hi) = (b.min.to_array(), b.max.to_array());
+            [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]].map(f32::to_bits)
         })
         .collect();
-    let indices: Vec<u32> = (0..triangles.len() as u32).collect();
-    let t_ploc = std::time::Instant::now();
+    keys.sort_unstable();
+    keys.chunk_by(|a, b| a == b).map(<[[u32; 6]]>::len).max().unwrap_or(0)
+}
+
+/// Why [`build_ploc`] builds `triangles` with [`SahBuilder`] instead of PLOC, if it does (for a
+/// caller to print): more than [`MAX_TIED`] of them are points at one place.
+pub fn ploc_fallback(triangles: &[Triangle]) -> Option<String> {
+    fallback_reason(largest_tie(&ploc_boxes(triangles)))
+}
+
+fn fallback_reason(tie: usize) -> Option<String> {
+    (tie > MAX_TIED).then(|| {
+        format!(
+            "{tie} triangles are points at one place, which PLOC clusters in time quadratic in their number;              the SAH builder builds this tree instead"
+        )
+    })
+}
+
+/// Runs obvhs: PLOC (on [`ploc_boxes`]), reinsertion, leaf collapse, reinsertion.
+#[cfg(test)]
+fn build_obvhs(triangles: &[Triangle]) -> obvhs::bvh2::Bvh2 {
+    build_obvhs_on(ploc_boxes(triangles))
+}
+
+/// Runs obvhs on the boxes of [`ploc_boxes`]: PLOC, reinsertion, leaf collapse, reinsertion.
+fn build_obvhs_on(boxes: Vec<obvhs::aabb::Aabb>) -> obvhs::bvh2::Bvh2 {
+    let p = obvhs_params();
+    let indices: Vec<u32> = (0..boxes.len() as u32).collect();
     let mut bvh = PlocBuilder::with_capacity(boxes.len()).build(
         p.ploc_search_distance,
         &boxes,
@@ -172,19 +196,15 @@ fn build_obvhs(triangles: &[Triangle]) -> obvhs::bvh2::Bvh2 {
         p.sort_precision,
         p.search_depth_threshold,
     );
-    eprintln!("DBG ploc {:?} depth {}", t_ploc.elapsed(), obvhs_depth(&bvh));
     let mut reinsertion = ReinsertionOptimizer::default();
     // Reinsertion's search stack holds 2 * `max_depth` entries and panics (or, in its fixed-size
     // variant, overwrites) beyond that. PLOC sets `max_depth` from its pass count, which a deepening
     // reinsertion can exceed: re-derive it from the actual depth before each pass.
     bvh.max_depth = bvh.max_depth.max(2 * obvhs_depth(&bvh) + 2);
     reinsertion.run(&mut bvh, p.reinsertion_batch_ratio, None);
-    eprintln!("DBG reins1 {:?} depth {}", t_ploc.elapsed(), obvhs_depth(&bvh));
     collapse(&mut bvh, p.max_prims_per_leaf.clamp(1, 255), p.collapse_traversal_cost);
     bvh.max_depth = bvh.max_depth.max(2 * obvhs_depth(&bvh) + 2);
-    eprintln!("DBG collapse {:?} depth {}", t_ploc.elapsed(), obvhs_depth(&bvh));
     reinsertion.run(&mut bvh, p.reinsertion_batch_ratio * p.post_collapse_reinsertion_batch_ratio_multiplier, None);
-    eprintln!("DBG reins2 {:?} depth {}", t_ploc.elapsed(), obvhs_depth(&bvh));
     bvh
 }
 
@@ -502,45 +522,32 @@ mod tests {
     #[test]
     fn coincident_triangles_work() {
         let tris = vec![Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y); 1000];
-        assert_eq!(largest_coincident_group(&tris), 1000);
-        assert!(coincident_fallback(&tris).is_none());
         let bvh = build_ploc(&tris, 63).unwrap();
         check(&bvh, &tris, 63);
     }
 
-    /// 100,000 copies of one triangle, and 30,000 of one triangle beside 5,000 others, build
-    /// within a second (PLOC took over a minute for the first): the SAH builder takes over.
+    /// Coincident and nearly coincident triangles build within a second (100,000 copies of one
+    /// triangle took PLOC over a minute, 30,000 took 22 s, a stack of 30,000 spaced 1e-5 apart 7 s):
+    /// the margins of [`ploc_boxes`] break PLOC's ties.
     #[test]
-    fn many_coincident_triangles_build_fast() {
+    fn coincident_and_nearly_coincident_triangles_build_fast() {
         let one = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+        let shifted = |d: Vec3| Triangle::new(one.v[0] + d, one.v[1] + d, one.v[2] + d);
         let mut mixed = random_triangles(5000, 5);
         mixed.extend(std::iter::repeat_n(one, 30_000));
-        // Nearly coincident: offsets far below a Morton cell.
-        let near: Vec<Triangle> = (0..30_000)
-            .map(|i| {
-                let d = Vec3::splat(i as f32 * 1e-12);
-                Triangle::new(one.v[0] + d, one.v[1] + d, one.v[2] + d)
-            })
-            .collect();
-        for sp in [1e-5f32] {
-            let stack: Vec<Triangle> = (0..30_000)
-                .map(|i| {
-                    let d = Vec3::new(0.0, 0.0, i as f32 * sp);
-                    Triangle::new(one.v[0] + d, one.v[1] + d, one.v[2] + d)
-                })
-                .collect();
-            let t = std::time::Instant::now();
-            let b = build_obvhs(&stack);
-            eprintln!("DBG stack {sp} obvhs {:?} depth {} group {}", t.elapsed(), obvhs_depth(&b), largest_coincident_group(&stack));
-        }
-        for tris in [vec![one; 100_000], mixed, near] {
+        let near: Vec<Triangle> = (0..30_000).map(|i| shifted(Vec3::splat(i as f32 * 1e-12))).collect();
+        let stack: Vec<Triangle> = (0..30_000).map(|i| shifted(Vec3::new(0.0, 0.0, i as f32 * 1e-5))).collect();
+        let points = vec![Triangle::new(Vec3::ONE, Vec3::ONE, Vec3::ONE); 30_000];
+        assert!(ploc_fallback(&points).is_some_and(|m| m.contains("SAH builder")));
+        for (name, tris) in
+            [("copies", vec![one; 100_000]), ("mixed", mixed), ("near", near), ("stack", stack), ("points", points)]
+        {
+            assert_eq!(ploc_fallback(&tris).is_some(), name == "points", "{name}");
             let start = std::time::Instant::now();
-            assert!(coincident_fallback(&tris).is_some_and(|m| m.contains("SAH builder")));
             let bvh = build_ploc(&tris, 63).unwrap();
-            assert!(start.elapsed() < std::time::Duration::from_secs(1), "{:?}", start.elapsed());
+            assert!(start.elapsed() < std::time::Duration::from_secs(1), "{name}: {:?}", start.elapsed());
             check(&bvh, &tris, 63);
         }
-        assert!(coincident_fallback(&random_triangles(5000, 5)).is_none());
     }
 
     #[test]

@@ -12,7 +12,7 @@
 mod agreement;
 mod json;
 mod measure;
-mod options;
+pub mod options;
 mod peers;
 mod plot;
 mod rays;
@@ -20,8 +20,9 @@ mod report;
 mod table;
 mod target;
 mod target_gpu;
-mod view;
+pub mod view;
 
+use crate::args::{check_input, check_output, Failure, Outcome};
 use crate::progress::{timed, Progress};
 use options::Options;
 use raytrail::core::mesh::LoadOptions;
@@ -31,21 +32,27 @@ use raytrail::core::trace::Trace;
 use raytrail::core::Hit;
 use raytrail::cpu::CpuScene;
 use raytrail::gpu::WgpuBackend;
+use raytrail_cli::write::write_atomically;
 use report::{BenchReport, Built, SceneReport};
+use std::io::Write;
 use std::sync::Arc;
 use target::{BenchTarget, RaytrailCpu, Targets};
 use target_gpu::RaytrailGpu;
 use view::Enclosure;
 
-/// Runs `raytrail bench` with the arguments after the subcommand.
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let opts = Options::parse(args)?;
-    check_baseline(&opts)?;
-    for path in opts.json.iter().chain(&opts.plot) {
-        let dir = std::path::Path::new(path).parent().filter(|d| !d.as_os_str().is_empty());
-        if dir.is_some_and(|d| !d.is_dir()) {
-            return Err(format!("cannot write {path}: its folder does not exist"));
-        }
+/// Runs `raytrail bench` with its flags; `args` are the arguments after the subcommand, as given,
+/// for the report.
+pub fn main(a: options::BenchArgs, args: &[String]) -> Outcome {
+    let opts = Options::from_args(&a).map_err(Failure::Usage)?;
+    check_baseline(&opts).map_err(Failure::Usage)?;
+    if let Some(path) = &opts.json {
+        check_output("json", path)?;
+    }
+    if let Some(path) = &opts.plot {
+        check_output("plot", path)?;
+    }
+    for path in &opts.scenes {
+        check_input("scene", path)?;
     }
     let pools = opts
         .threads
@@ -74,11 +81,13 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         scenes,
     };
     if let Some(path) = &opts.json {
-        std::fs::write(path, json::to_json(&report)).map_err(|e| format!("cannot write {path}: {e}"))?;
+        write_atomically(path, |w| w.write_all(json::to_json(&report).as_bytes()))
+            .map_err(|e| format!("cannot write {path}: {e}"))?;
         eprintln!("wrote {path}");
     }
     if let Some(path) = &opts.plot {
-        std::fs::write(path, plot::to_svg(&report)).map_err(|e| format!("cannot write {path}: {e}"))?;
+        write_atomically(path, |w| w.write_all(plot::to_svg(&report).as_bytes()))
+            .map_err(|e| format!("cannot write {path}: {e}"))?;
         eprintln!("wrote {path}");
     }
     Ok(0)
@@ -112,6 +121,7 @@ fn bench_scene(
     crate::args::warn(&warning);
     let scene = &named.scene;
     let largest = &pools.last().ok_or("no thread pool")?.1;
+    crate::args::ploc_note(opts.builder, scene);
 
     let (bvh, tree_s) = timed(
         &format!("building raytrail's BVH2 ({}, {} triangles)", opts.builder.name(), scene.triangles().len()),

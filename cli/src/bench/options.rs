@@ -2,15 +2,10 @@
 
 use super::rays::RayKind;
 use super::view::ViewChoice;
-use crate::args::{Args, STRICT};
+use crate::args::{LoadFlags, BUILDERS};
+use clap::Parser;
 use raytrail::core::method::Method;
 use raytrail::{Builder, BUILTIN_SCENE};
-
-/// Every flag `raytrail bench` knows.
-const FLAGS: &[&str] = &[
-    "scene", "rays", "width", "height", "passes", "threads", "methods", "peers", "baseline", "json", "plot", "builder",
-    "ao-rays", "no-gpu", "view", STRICT,
-];
 
 /// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
 /// follow from the primary hits). With the three scenes of BENCHMARKS.md (Sponza, the kitchen, the
@@ -69,16 +64,77 @@ pub struct Options {
     pub strict: bool,
 }
 
+/// The `raytrail bench` flags as given; [`Options::from_args`] checks them.
+#[derive(Parser, Debug, Clone)]
+#[command(name = "bench")]
+pub struct BenchArgs {
+    /// Scene files (or `builtin`), comma-separated
+    #[arg(long, short = 's', value_name = "FILE[,FILE...]", default_value = BUILTIN_SCENE)]
+    pub scene: String,
+    /// Ray types, comma-separated: primary, shadow, diffuse, ao [default: all]
+    #[arg(long, value_name = "TYPE[,TYPE...]")]
+    pub rays: Option<String>,
+    /// Primary image width
+    #[arg(long, short = 'W', default_value_t = DEFAULT_SIZE)]
+    pub width: u32,
+    /// Primary image height
+    #[arg(long, short = 'H', default_value_t = DEFAULT_SIZE)]
+    pub height: u32,
+    /// Timed passes per measurement, after one warm-up pass (the median is reported)
+    #[arg(long, default_value_t = DEFAULT_PASSES)]
+    pub passes: usize,
+    /// Thread counts, comma-separated [default: 1 and all]
+    #[arg(long, short = 'j', value_name = "N[,N...]")]
+    pub threads: Option<String>,
+    /// raytrail methods, comma-separated, or all or none
+    #[arg(long, value_name = "NAME,...|all|none", default_value = "all")]
+    pub methods: String,
+    /// Peers, comma-separated (obvhs-bvh2, obvhs-cwbvh, bvh; each also NAME+wt; embree with the
+    /// `embree` feature), or all or none
+    #[arg(long, value_name = "NAME,...|all|none", default_value = "all")]
+    pub peers: String,
+    /// Target the ratio column divides by [default: obvhs-bvh2, or the first method without peers]
+    #[arg(long, value_name = "NAME")]
+    pub baseline: Option<String>,
+    /// Also write the results as JSON
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<String>,
+    /// Also write an SVG plot of the results
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<String>,
+    /// BVH2 builder of raytrail's tree
+    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    pub builder: String,
+    /// Ambient-occlusion rays per primary hit (1 to 64)
+    #[arg(long, default_value_t = DEFAULT_AO_RAYS)]
+    pub ao_rays: usize,
+    /// Leave the GPU out even when wgpu finds an adapter
+    #[arg(long)]
+    pub no_gpu: bool,
+    /// Camera views: outside, inside, both, or auto (inside too where it sees a room)
+    #[arg(long, default_value = ViewChoice::DEFAULT.name(), value_parser = ViewChoice::ALL.map(ViewChoice::name))]
+    pub view: String,
+    #[command(flatten)]
+    pub load: LoadFlags,
+}
+
 impl Options {
-    /// Parses and checks the flags after `raytrail bench`.
+    /// Parses and checks the flags after `raytrail bench` (as [`BenchArgs`] and
+    /// [`Options::from_args`]); an error is a usage error.
+    #[cfg(test)]
     pub fn parse(args: &[String]) -> Result<Options, String> {
-        let a = Args::parse(args, &["no-gpu", STRICT])?;
-        a.only(FLAGS)?;
-        let scenes = list(a.get("scene").unwrap_or(BUILTIN_SCENE));
+        let a = BenchArgs::try_parse_from(std::iter::once("bench".to_string()).chain(args.iter().cloned()))
+            .map_err(|e| e.to_string())?;
+        Options::from_args(&a)
+    }
+
+    /// Checks the flags of `raytrail bench`; an error is a usage error.
+    pub fn from_args(a: &BenchArgs) -> Result<Options, String> {
+        let scenes = list(&a.scene);
         if scenes.is_empty() {
             return Err("--scene: no scene given".to_string());
         }
-        let rays = match a.get("rays") {
+        let rays = match a.rays.as_deref() {
             None => RayKind::ALL.to_vec(),
             Some(v) => unique(
                 list(v)
@@ -94,10 +150,10 @@ impl Options {
                     .collect::<Result<_, _>>()?,
             ),
         };
-        let methods = match a.get("methods") {
-            None | Some("all") => Method::ALL.to_vec(),
-            Some("none") => Vec::new(),
-            Some(v) => unique(
+        let methods = match a.methods.as_str() {
+            "all" => Method::ALL.to_vec(),
+            "none" => Vec::new(),
+            v => unique(
                 list(v)
                     .iter()
                     .map(|n| {
@@ -111,10 +167,10 @@ impl Options {
                     .collect::<Result<_, _>>()?,
             ),
         };
-        let peers = match a.get("peers") {
-            None | Some("all") => PEERS.iter().map(|p| p.to_string()).collect(),
-            Some("none") => Vec::new(),
-            Some(v) => {
+        let peers = match a.peers.as_str() {
+            "all" => PEERS.iter().map(|p| p.to_string()).collect(),
+            "none" => Vec::new(),
+            v => {
                 let given = unique(list(v));
                 if let Some(bad) = given.iter().find(|p| !PEERS.contains(&p.as_str())) {
                     if bad == "embree" {
@@ -131,20 +187,20 @@ impl Options {
         if rays.is_empty() || (methods.is_empty() && peers.is_empty()) {
             return Err("nothing to measure: give at least one ray type and one method or peer".to_string());
         }
-        let (width, height) = (a.num("width", DEFAULT_SIZE)?, a.num("height", DEFAULT_SIZE)?);
+        let (width, height) = (a.width, a.height);
         if width == 0 || height == 0 || u64::from(width) * u64::from(height) > 1 << 26 {
             return Err(format!("--width/--height: {width} x {height} must be at least 1 x 1 and at most 2^26 pixels"));
         }
-        let passes = a.num("passes", DEFAULT_PASSES)?;
+        let passes = a.passes;
         if passes == 0 {
             return Err("--passes must be at least 1".to_string());
         }
-        let ao_rays = a.num("ao-rays", DEFAULT_AO_RAYS)?;
+        let ao_rays = a.ao_rays;
         if ao_rays == 0 || ao_rays > 64 {
             return Err("--ao-rays must be between 1 and 64".to_string());
         }
         let all = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let threads = match a.get("threads") {
+        let threads = match a.threads.as_deref() {
             None => unique(vec![1, all]),
             Some(v) => {
                 let mut t: Vec<usize> = list(v)
@@ -163,7 +219,7 @@ impl Options {
             return Err("--threads: no thread count given".to_string());
         }
         // Without peers, the default baseline is the first method run.
-        let baseline = match (a.get("baseline"), methods.first()) {
+        let baseline = match (a.baseline.as_deref(), methods.first()) {
             (Some(b), _) => b.to_string(),
             (None, Some(first)) if peers.is_empty() => first.name().to_string(),
             (None, _) => "obvhs-bvh2".to_string(),
@@ -178,13 +234,13 @@ impl Options {
             methods,
             peers,
             baseline,
-            json: a.get("json").map(str::to_string),
-            plot: a.get("plot").map(str::to_string),
-            builder: Builder::from_name(a.get("builder").unwrap_or("sah"))?,
+            json: a.json.clone(),
+            plot: a.plot.clone(),
+            builder: Builder::from_name(&a.builder)?,
             ao_rays,
-            no_gpu: a.has("no-gpu"),
-            view: ViewChoice::from_name(a.get("view").unwrap_or(ViewChoice::DEFAULT.name()))?,
-            strict: a.has(STRICT),
+            no_gpu: a.no_gpu,
+            view: ViewChoice::from_name(&a.view)?,
+            strict: a.load.strict,
         })
     }
 }
@@ -226,7 +282,7 @@ mod tests {
         assert!(!o.strict && parse("--strict").unwrap().strict);
         assert_eq!(parse("--view both").unwrap().view, ViewChoice::Both);
         let e = parse("--scene a.obj --colour red").unwrap_err();
-        assert!(e.contains("unknown flag --colour"), "{e}");
+        assert!(e.contains("unexpected argument '--colour'"), "{e}");
         let o = parse("--scene a.obj,,b.ply --rays ao,primary,ao --threads 2,1,2 --methods hash,stack").unwrap();
         assert_eq!(o.scenes, vec!["a.obj", "b.ply"]);
         assert_eq!(o.rays, vec![RayKind::Ao, RayKind::Primary]);
