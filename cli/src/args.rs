@@ -145,17 +145,27 @@ pub enum Command {
 }
 
 /// The mesh loading flags.
-#[derive(clap::Args, Debug, Clone, Default, PartialEq, Eq)]
+#[derive(clap::Args, Debug, Clone, PartialEq, Eq)]
 pub struct LoadFlags {
     /// Fail on mesh elements that are not triangles or polygons instead of skipping them
     #[arg(long)]
     pub strict: bool,
+    /// Largest size a gzip-compressed mesh may inflate to, in bytes
+    #[arg(long, value_name = "BYTES", default_value_t = LoadOptions::DEFAULT_MAX_INFLATED)]
+    pub max_mesh_bytes: u64,
+}
+
+impl Default for LoadFlags {
+    /// The defaults the command line has.
+    fn default() -> Self {
+        LoadFlags { strict: false, max_mesh_bytes: LoadOptions::DEFAULT_MAX_INFLATED }
+    }
 }
 
 impl LoadFlags {
     /// The mesh loading policy of [`STRICT`].
     pub fn load_options(&self) -> LoadOptions {
-        LoadOptions { strict: self.strict, ..LoadOptions::default() }
+        LoadOptions { strict: self.strict, max_inflated: self.max_mesh_bytes, ..LoadOptions::default() }
     }
 }
 

@@ -355,3 +355,24 @@ fn ploc_on_coincident_triangles_is_fast() {
         assert_eq!(err.contains("the SAH builder builds this tree instead"), warns, "{name}: {err}");
     }
 }
+
+/// A small gzip that inflates far beyond the limit on decompressed meshes is an error within a
+/// second, not an allocation abort; the limit is a flag.
+#[test]
+fn a_gzip_bomb_is_an_error_not_an_abort() {
+    use std::io::Write;
+    let dir = folder("gzip_bomb");
+    let bomb = dir.join("bomb.obj.gz");
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    let zeros = vec![b'#'; 1 << 20];
+    for _ in 0..64 {
+        gz.write_all(&zeros).unwrap();
+    }
+    std::fs::write(&bomb, gz.finish().unwrap()).unwrap();
+    let start = std::time::Instant::now();
+    let out = run(&["rays", "--scene", p(&bomb), "--out", p(&dir.join("r.npy")), "--max-mesh-bytes", "1000000"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("inflates to more than 1000000 bytes") && !err.contains("panicked"), "{err}");
+    assert!(start.elapsed().as_secs_f64() < 1.0, "took {:?}", start.elapsed());
+}

@@ -239,8 +239,8 @@ fn same_triangles_in_every_format() {
     dir.write("sample buffer.bin", &gltf_buffer(&m));
     for (file, data) in &files {
         let path = dir.write(file, data);
-        let (mesh, report) =
-            load_with(&path, &LoadOptions { strict: true, sources: true }).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let (mesh, report) = load_with(&path, &LoadOptions { strict: true, sources: true, ..LoadOptions::default() })
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
         assert_eq!(corner_bits(&mesh), want, "{file}: triangles differ");
         assert_eq!(report.skipped, 0, "{file}");
         assert_eq!(report.sources.len(), m.triangles.len(), "{file}");
@@ -260,7 +260,7 @@ fn same_triangles_in_every_format() {
 #[test]
 fn sources_name_the_face_in_each_format() {
     let m = sample();
-    let options = LoadOptions { strict: false, sources: true };
+    let options = LoadOptions { strict: false, sources: true, ..LoadOptions::default() };
     let sources = |file: &str, data: &[u8]| load_bytes_with(data, file, &options).unwrap().1.sources;
     let n = m.triangles.len() as u64;
     // OBJ: lines (one comment, then the vertices, then the faces).
@@ -431,8 +431,8 @@ fn real_stl_spider_ascii_and_binary_agree() {
 #[test]
 fn real_glb_engine_with_node_transforms() {
     let Some(path) = fetched("2CylinderEngine.glb") else { return };
-    let (mesh, report) =
-        load_with(&path, &LoadOptions { strict: true, sources: true }).unwrap_or_else(|e| panic!("{e}"));
+    let (mesh, report) = load_with(&path, &LoadOptions { strict: true, sources: true, ..LoadOptions::default() })
+        .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(mesh.triangles.len(), 121_496);
     let scene = mesh.to_scene().unwrap();
     // Bounds and mean corner of the transformed triangles, computed independently (in f64, from

@@ -623,7 +623,7 @@ mod tests {
     use super::*;
 
     fn load(data: &[u8]) -> Result<(Mesh, LoadReport), String> {
-        parse(data, "t.gltf", None, &LoadOptions { strict: false, sources: true }).map_err(|e| e.to_string())
+        parse(data, "t.gltf", None, &LoadOptions { sources: true, ..LoadOptions::default() }).map_err(|e| e.to_string())
     }
 
     fn b64(bytes: &[u8]) -> String {

@@ -48,19 +48,33 @@ use std::string::{String, ToString};
 use std::vec::Vec;
 
 /// How a file is loaded.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoadOptions {
     /// Fail on the first element that is not a triangle or polygon, instead of skipping it.
     pub strict: bool,
     /// Fill [`LoadReport::sources`]: where in the file each kept triangle comes from.
     pub sources: bool,
+    /// Largest size a gzip-compressed file may inflate to, in bytes; past it loading fails with
+    /// an error saying so (a few megabytes of gzip can claim gigabytes).
+    pub max_inflated: u64,
+}
+
+impl Default for LoadOptions {
+    /// [`LoadOptions::LENIENT`].
+    fn default() -> Self {
+        LoadOptions::LENIENT
+    }
 }
 
 impl LoadOptions {
     /// The default policy: skip elements that are not triangles or polygons, no source map.
-    pub const LENIENT: LoadOptions = LoadOptions { strict: false, sources: false };
+    pub const LENIENT: LoadOptions =
+        LoadOptions { strict: false, sources: false, max_inflated: LoadOptions::DEFAULT_MAX_INFLATED };
     /// Fail on elements that are not triangles or polygons.
-    pub const STRICT: LoadOptions = LoadOptions { strict: true, sources: false };
+    pub const STRICT: LoadOptions = LoadOptions { strict: true, ..LoadOptions::LENIENT };
+    /// The default [`LoadOptions::max_inflated`]: 4 GiB, far beyond any mesh the tests or benches
+    /// read (the full dragon inflates to 30 MB) and below what a small gzip bomb claims.
+    pub const DEFAULT_MAX_INFLATED: u64 = 4 << 30;
 }
 
 /// What loading a file skipped, and where the triangles came from.
@@ -230,7 +244,7 @@ fn load_data(
     }
     let stem = strip_suffix_ignore_case(name, ".gz");
     if data.starts_with(&GZIP_MAGIC) {
-        let raw = gunzip(data, name)?;
+        let raw = gunzip(data, name, options.max_inflated)?;
         if raw.is_empty() {
             return Err(MeshError::new(name, "file is empty after gzip decompression"));
         }
@@ -300,13 +314,39 @@ fn parse(
     }
 }
 
-fn gunzip(data: &[u8], name: &str) -> Result<Vec<u8>, MeshError> {
-    let mut raw = Vec::new();
+/// Inflates `data`, at most `max` bytes of it, growing the buffer by fallible reservations: a
+/// file that inflates further, or beyond what memory can hold, is an error rather than an abort.
+fn gunzip(data: &[u8], name: &str, max: u64) -> Result<Vec<u8>, MeshError> {
+    let mut raw: Vec<u8> = Vec::new();
     // Multi-member: `cat a.gz b.gz` is valid gzip and some tools write it.
-    flate2::read::MultiGzDecoder::new(data)
-        .read_to_end(&mut raw)
-        .map_err(|e| MeshError::io(name, "gzip data is corrupt or truncated", e))?;
-    Ok(raw)
+    let mut decoder = flate2::read::MultiGzDecoder::new(data);
+    let mut chunk = [0u8; 1 << 16];
+    loop {
+        let n = match decoder.read(&mut chunk) {
+            Ok(0) => return Ok(raw),
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(MeshError::io(name, "gzip data is corrupt or truncated", e)),
+        };
+        if (raw.len() + n) as u64 > max {
+            return Err(MeshError::new(
+                name,
+                &std::format!("inflates to more than {max} bytes, the limit for decompressed meshes (LoadOptions::max_inflated; the CLI's --max-mesh-bytes)"),
+            ));
+        }
+        // Doubling, as `Vec` grows, but asking first.
+        if raw.capacity() - raw.len() < n {
+            let room = usize::try_from(max).unwrap_or(usize::MAX) - raw.len();
+            let want = raw.capacity().max(n).min(room);
+            raw.try_reserve(want).map_err(|_| {
+                MeshError::new(
+                    name,
+                    &std::format!("cannot hold {} bytes of decompressed data in memory", raw.len() + want),
+                )
+            })?;
+        }
+        raw.extend_from_slice(&chunk[..n]);
+    }
 }
 
 fn strip_suffix_ignore_case<'a>(s: &'a str, suffix: &str) -> Option<&'a str> {
@@ -362,6 +402,18 @@ property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_he
     const TRI_OFF: &[u8] = b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     const TRI_STL: &[u8] = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n\
 endloop\nendfacet\nendsolid t\n";
+
+    #[test]
+    fn a_gzip_that_inflates_past_the_limit_is_an_error() {
+        let big = std::vec![b'#'; 3 << 20];
+        let small = gzip(&big);
+        assert!(small.len() < 64 << 10, "{} bytes of gzip", small.len());
+        let options = LoadOptions { max_inflated: 1 << 20, ..LoadOptions::default() };
+        let err = load_bytes_with(&small, "bomb.obj.gz", &options).unwrap_err().to_string();
+        assert!(err.contains("inflates to more than 1048576 bytes"), "{err}");
+        // Under the default limit the same file inflates (and is an OBJ of comments: no triangles).
+        assert!(load_bytes(&small, "bomb.obj.gz").map(|m| m.triangles.is_empty()).unwrap_or(true));
+    }
 
     #[test]
     fn dispatch_by_extension_and_gzip_magic() {

@@ -324,7 +324,8 @@ mod tests {
     }
 
     fn lenient(text: &str) -> (Mesh, LoadReport) {
-        parse(text.as_bytes(), "t.obj", &LoadOptions { strict: false, sources: true }).unwrap()
+        parse(text.as_bytes(), "t.obj", &LoadOptions { strict: false, sources: true, ..LoadOptions::default() })
+            .unwrap()
     }
 
     #[test]

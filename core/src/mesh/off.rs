@@ -191,7 +191,8 @@ mod tests {
     use std::string::ToString;
 
     fn load(text: &str) -> (Mesh, LoadReport) {
-        parse(text.as_bytes(), "t.off", &LoadOptions { strict: false, sources: true }).unwrap()
+        parse(text.as_bytes(), "t.off", &LoadOptions { strict: false, sources: true, ..LoadOptions::default() })
+            .unwrap()
     }
 
     fn err(text: &str) -> String {

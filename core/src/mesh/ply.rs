@@ -661,7 +661,7 @@ end_header\r\n0.5 2 0.25 0.75 1 255 -3\r\n1 0 0 0 0\r\n2 1 3 4 0 7\r\n\r\n2 0 1 
 
     #[test]
     fn short_faces_are_skipped_and_counted() {
-        let options = LoadOptions { strict: false, sources: true };
+        let options = LoadOptions { strict: false, sources: true, ..LoadOptions::default() };
         let text =
             format!("{}0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 1\n4 0 1 2 3\n0\n1 3\n", HEAD.replace("face 1", "face 4"));
         let (m, report) = parse(text.as_bytes(), "t.ply", &options).unwrap();

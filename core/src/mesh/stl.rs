@@ -248,7 +248,7 @@ mod tests {
     use std::string::ToString;
 
     fn load(data: &[u8]) -> (Mesh, LoadReport) {
-        parse(data, "t.stl", &LoadOptions { strict: false, sources: true }).unwrap()
+        parse(data, "t.stl", &LoadOptions { strict: false, sources: true, ..LoadOptions::default() }).unwrap()
     }
 
     fn err(data: &[u8]) -> String {
