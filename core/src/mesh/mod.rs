@@ -331,7 +331,7 @@ fn gunzip(data: &[u8], name: &str, max: u64) -> Result<Vec<u8>, MeshError> {
         if (raw.len() + n) as u64 > max {
             return Err(MeshError::new(
                 name,
-                &std::format!("inflates to more than {max} bytes, the limit for decompressed meshes (LoadOptions::max_inflated; the CLI's --max-mesh-bytes)"),
+                std::format!("inflates to more than {max} bytes, the limit for decompressed meshes (LoadOptions::max_inflated; the CLI's --max-mesh-bytes)"),
             ));
         }
         // Doubling, as `Vec` grows, but asking first.
@@ -341,7 +341,7 @@ fn gunzip(data: &[u8], name: &str, max: u64) -> Result<Vec<u8>, MeshError> {
             raw.try_reserve(want).map_err(|_| {
                 MeshError::new(
                     name,
-                    &std::format!("cannot hold {} bytes of decompressed data in memory", raw.len() + want),
+                    std::format!("cannot hold {} bytes of decompressed data in memory", raw.len() + want),
                 )
             })?;
         }
