@@ -7,6 +7,7 @@
 //! most [`PACKET_WIDTH`] rays. Packets never span two chunks, so a backend may trace chunks in
 //! parallel.
 
+#[cfg(feature = "alloc")]
 use super::PACKET_WIDTH;
 use crate::Ray;
 #[cfg(feature = "alloc")]
