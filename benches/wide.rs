@@ -40,31 +40,14 @@ const METHODS: &[Method] = &[
 /// Length of an ambient-occlusion ray as a fraction of the scene's diagonal (the CLI bench's).
 const AO_RADIUS: f32 = 0.05;
 
-/// [`FastKernel`], but any-hit queries also visit hit children nearest first: what Guthe's
-/// unsorted occlusion (Sec. 4.2) saves.
-struct SortedAnyKernel;
+/// [`FastKernel`] with its two switches set by hand: `SORTED_ANY` (any-hit queries also visit hit
+/// children nearest first: what Guthe's unsorted occlusion, Sec. 4.2, saves) and `BLOCKS` (leaves
+/// four triangles at once: what the unrolled triangle loop, Sec. 4, saves).
+struct Switched<const BLOCKS: bool, const SORTED_ANY: bool>;
 
-impl ChildKernel for SortedAnyKernel {
-    const BLOCKS: bool = FastKernel::BLOCKS;
-    const SORTED_ANY: bool = true;
-
-    #[inline(always)]
-    fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
-        FastKernel::test(node, slab, tmin, tmax)
-    }
-
-    #[inline(always)]
-    fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
-        FastKernel::order(hits, order)
-    }
-}
-
-/// [`FastKernel`], but leaves are tested one triangle at a time: what the 4-at-once leaf test
-/// (Guthe's unrolled triangle loop, Sec. 4) saves.
-struct OneTriKernel;
-
-impl ChildKernel for OneTriKernel {
-    const BLOCKS: bool = false;
+impl<const B: bool, const S: bool> ChildKernel for Switched<B, S> {
+    const BLOCKS: bool = B;
+    const SORTED_ANY: bool = S;
 
     #[inline(always)]
     fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
@@ -76,6 +59,11 @@ impl ChildKernel for OneTriKernel {
         FastKernel::order(hits, order)
     }
 }
+
+/// Sorted occlusion, leaves in blocks.
+type SortedAnyKernel = Switched<true, true>;
+/// Unsorted occlusion, leaves one triangle at a time.
+type OneTriKernel = Switched<false, false>;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kernel {
