@@ -25,7 +25,7 @@ use raytrail::core::observe::NoObserver;
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::scene::Scene;
 use raytrail::core::wide::traverse::{trace_wide_batch, WideRoot};
-use raytrail::core::wide::{ChildHits, ChildKernel, FastKernel, WideNode, WideSliceMemory};
+use raytrail::core::wide::{ChildHits, ChildKernel, FastKernel, WideNode, WideSliceMemory, WideTree};
 use raytrail::core::{Hit, Ray};
 use raytrail::Builder;
 use std::time::Duration;
@@ -124,9 +124,9 @@ fn trace(p: &PreparedScene, variant: Variant, rays: &[Ray], hits: &mut [Hit], qu
         }
         Variant::Wide(m, kernel) => {
             let root = p.wide_root(m).expect("root");
-            match m.width() {
-                4 => wide::<4>(&p.wide4(m).expect("tree").memory(), root, kernel, rays, hits, query),
-                _ => wide::<8>(&p.wide8(m).expect("tree").memory(), root, kernel, rays, hits, query),
+            match p.wide_tree(m).expect("tree") {
+                WideTree::Four(t) => wide::<4>(&t.memory(), root, kernel, rays, hits, query),
+                WideTree::Eight(t) => wide::<8>(&t.memory(), root, kernel, rays, hits, query),
             }
         }
     }

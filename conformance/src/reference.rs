@@ -12,7 +12,7 @@ use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
-use raytrail_core::wide::{ReferenceKernel, WideSliceMemory};
+use raytrail_core::wide::{ReferenceKernel, WideSliceMemory, WideTree};
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 use std::time::Instant;
@@ -29,10 +29,9 @@ impl SerialBackend {
     fn trace_all<T: TriangleTest>(
         scene: &PreparedScene,
         method: Method,
-        opts: &TraceOptions,
+        query: Query,
         rays: &[Ray],
     ) -> Result<Vec<Traced>, Error> {
-        let query = opts.query;
         let fresh = || Both(Counters::default(), Recorder::default());
         match method {
             Method::Bvh2(m) => {
@@ -76,9 +75,9 @@ impl SerialBackend {
             }
             Method::Wide(m) => {
                 let root = scene.wide_root(m)?;
-                match m.width() {
-                    4 => Ok(Self::wide::<_, T>(&scene.wide4(m)?.memory(), root, rays, query)),
-                    _ => Ok(Self::wide::<_, T>(&scene.wide8(m)?.memory(), root, rays, query)),
+                match scene.wide_tree(m)? {
+                    WideTree::Four(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query)),
+                    WideTree::Eight(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query)),
                 }
             }
             other => Err(Error::Unsupported { method: other.name(), by: "the serial reference backend" }),
@@ -131,8 +130,10 @@ impl Trace for SerialBackend {
         scene.check_prepared(opts.method)?;
         let start = Instant::now();
         let traced = match opts.triangle_test {
-            TriangleTestKind::Watertight => Self::trace_all::<Watertight>(scene, opts.method, opts, rays)?,
-            TriangleTestKind::MollerTrumbore => Self::trace_all::<MollerTrumbore>(scene, opts.method, opts, rays)?,
+            TriangleTestKind::Watertight => Self::trace_all::<Watertight>(scene, opts.method, opts.query, rays)?,
+            TriangleTestKind::MollerTrumbore => {
+                Self::trace_all::<MollerTrumbore>(scene, opts.method, opts.query, rays)?
+            }
         };
         let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());
         let mut counters = Counters::default();

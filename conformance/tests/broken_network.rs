@@ -14,7 +14,7 @@ use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
 use raytrail_core::wide::network::sort_network_without;
 use raytrail_core::wide::traverse::trace_wide_ray;
-use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideNode};
+use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideNode, WideTree};
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 
@@ -63,20 +63,20 @@ impl<const D: usize> Trace for Faulty<D> {
     ) -> Result<Report, Error> {
         check_buffers(rays, hits)?;
         let m = WideMethod::try_from(opts.method)?;
-        let root = scene.wide_root(m)?;
+        let (root, tree) = (scene.wide_root(m)?, scene.wide_tree(m)?);
         let mut enumerations = Vec::new();
         for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
             let mut o = Both(Counters::default(), Recorder::default());
-            *hit = match m.width() {
-                4 => trace_wide_ray::<4, _, Watertight, DroppedExchange<D>, _>(
-                    &scene.wide4(m)?.memory(),
+            *hit = match tree {
+                WideTree::Four(t) => trace_wide_ray::<4, _, Watertight, DroppedExchange<D>, _>(
+                    &t.memory(),
                     root,
                     ray,
                     opts.query,
                     &mut o,
                 ),
-                _ => trace_wide_ray::<8, _, Watertight, DroppedExchange<D>, _>(
-                    &scene.wide8(m)?.memory(),
+                WideTree::Eight(t) => trace_wide_ray::<8, _, Watertight, DroppedExchange<D>, _>(
+                    &t.memory(),
                     root,
                     ray,
                     opts.query,

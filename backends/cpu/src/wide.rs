@@ -10,7 +10,7 @@ use raytrail_core::observe::{Both, Counters, NoObserver, Observer, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
-use raytrail_core::wide::{FastKernel, WideSliceMemory};
+use raytrail_core::wide::{FastKernel, WideSliceMemory, WideTree};
 use raytrail_core::{Error, Hit, Ray};
 
 /// Traces one chunk with `method`; returns its counters.
@@ -21,9 +21,9 @@ pub(crate) fn trace_chunk(
     chunk: Chunk<'_>,
 ) -> Result<Counters, Error> {
     let root = scene.wide_root(method)?;
-    match method.width() {
-        4 => WideRun { scene, method, opts, mem: scene.wide4(method)?.memory(), root }.go(chunk),
-        _ => WideRun { scene, method, opts, mem: scene.wide8(method)?.memory(), root }.go(chunk),
+    match scene.wide_tree(method)? {
+        WideTree::Four(t) => WideRun { scene, method, opts, mem: t.memory(), root }.go(chunk),
+        WideTree::Eight(t) => WideRun { scene, method, opts, mem: t.memory(), root }.go(chunk),
     }
 }
 

@@ -128,7 +128,7 @@ pub fn ray_sets(scene: &Scene, size: RaySetSize, trace_closest: &mut dyn FnMut(&
 /// rounding for geometry far from the origin.
 pub fn scene_epsilon(bounds: Aabb) -> f32 {
     let diagonal = bounds.extent().length();
-    let magnitude = bounds.min.abs().max(bounds.max.abs()).max_element();
+    let magnitude = bounds.max_abs();
     (1e-5 * diagonal).max(magnitude * (1.0 / (1u32 << 20) as f32)).max(f32::MIN_POSITIVE)
 }
 

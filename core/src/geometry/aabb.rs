@@ -48,6 +48,13 @@ impl Aabb {
         (self.min + self.max) * 0.5
     }
 
+    /// The largest coordinate magnitude in the box: the scale every distance error is relative
+    /// to (the per-ray slack, the kd builder's plane margin).
+    #[inline]
+    pub fn max_abs(&self) -> f32 {
+        self.min.abs().max(self.max.abs()).max_element()
+    }
+
     /// Half the surface area (the constant factor cancels in the SAH).
     #[inline]
     pub fn half_area(&self) -> f32 {

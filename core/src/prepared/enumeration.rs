@@ -25,14 +25,8 @@ impl PreparedScene {
             Method::Kd(_) => Ok(refs.into_iter().filter(|r| r.is_leaf()).map(|r| r.offset()).collect()),
             // Wide nodes and leaves by the binary node each stands for.
             Method::Wide(m) => {
-                let id = |r: NodeRef| -> Option<u32> {
-                    match m.width() {
-                        4 => self.wide4(m).ok()?.canonical_id(r),
-                        _ => self.wide8(m).ok()?.canonical_id(r),
-                    }
-                };
-                self.check_prepared(method)?;
-                Ok(refs.into_iter().map(|r| id(r).unwrap_or(UNKNOWN_NODE)).collect())
+                let tree = self.wide_tree(m)?;
+                Ok(refs.into_iter().map(|r| tree.canonical_id(r).unwrap_or(UNKNOWN_NODE)).collect())
             }
         }
     }

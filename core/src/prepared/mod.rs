@@ -13,7 +13,7 @@ use crate::key::KeyWidth;
 use crate::method::{Bvh2Method, Method, Structure, WideMethod};
 use crate::scene::Scene;
 use crate::wide::traverse::WideRoot;
-use crate::wide::WideBvh;
+use crate::wide::{WideBvh, WideTree};
 use crate::Error;
 use alloc::vec::Vec;
 
@@ -182,10 +182,15 @@ impl PreparedScene {
         })
     }
 
+    /// The largest coordinate magnitude of the scene (its canonical tree's root box), which the
+    /// per-ray slack of the BVH2 and wide methods is made from.
+    pub fn scene_scale(&self) -> f32 {
+        self.bvh.nodes()[0].bounds.max_abs()
+    }
+
     /// Where `method` starts.
     pub fn root(&self, method: Bvh2Method) -> Result<TraceRoot, Error> {
-        let b = self.bvh.nodes()[0].bounds;
-        let scene_scale = b.min.abs().max(b.max.abs()).max_element();
+        let scene_scale = self.scene_scale();
         Ok(TraceRoot { node: self.layout(method)?.root, scene_scale, max_steps: self.bvh.len() as u32 })
     }
 
@@ -202,43 +207,30 @@ impl PreparedScene {
         Ok(KdRoot {
             lo: b.min,
             hi: b.max,
-            scene_scale: b.min.abs().max(b.max.abs()).max_element(),
+            scene_scale: b.max_abs(),
             max_steps: (kd.tree.nodes().len() + 66 * kd.tree.stats().leaves).min(u32::MAX as usize) as u32,
             short_stack: kd.short_stack,
         })
     }
 
-    /// The 4-wide tree `method` traverses ([`WideMethod::Bvh4`] or [`WideMethod::Bvh4Naive`]).
-    pub fn wide4(&self, method: WideMethod) -> Result<&WideBvh<4>, Error> {
-        let tree = match method {
-            WideMethod::Bvh4 => &self.wide4,
-            WideMethod::Bvh4Naive => &self.wide4_naive,
-            WideMethod::Bvh8 => return Err(Error::Unsupported { method: method.name(), by: "a 4-wide traversal" }),
-        };
-        tree.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "its 4-wide tree" })
-    }
-
-    /// The 8-wide tree `method` traverses ([`WideMethod::Bvh8`]).
-    pub fn wide8(&self, method: WideMethod) -> Result<&WideBvh<8>, Error> {
-        match method {
-            WideMethod::Bvh8 => {
-                self.wide8.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "its 8-wide tree" })
-            }
-            _ => Err(Error::Unsupported { method: method.name(), by: "an 8-wide traversal" }),
-        }
+    /// The wide tree `method` traverses, of its width.
+    pub fn wide_tree(&self, method: WideMethod) -> Result<WideTree<'_>, Error> {
+        let missing = || Error::NotPrepared { method: method.name(), missing: "its wide tree" };
+        Ok(match method {
+            WideMethod::Bvh4 => WideTree::Four(self.wide4.as_ref().ok_or_else(missing)?),
+            WideMethod::Bvh4Naive => WideTree::Four(self.wide4_naive.as_ref().ok_or_else(missing)?),
+            WideMethod::Bvh8 => WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?),
+        })
     }
 
     /// Where `method` starts, with the BVH2 methods' scene scale (so its slack is theirs).
     pub fn wide_root(&self, method: WideMethod) -> Result<WideRoot, Error> {
-        let (root, nodes, leaves) = match method.width() {
-            4 => self.wide4(method).map(|t| (t.root(), t.stats().nodes, t.stats().leaves))?,
-            _ => self.wide8(method).map(|t| (t.root(), t.stats().nodes, t.stats().leaves))?,
-        };
-        let b = self.bvh.nodes()[0].bounds;
+        let tree = self.wide_tree(method)?;
+        let stats = tree.stats();
         Ok(WideRoot {
-            root,
-            scene_scale: b.min.abs().max(b.max.abs()).max_element(),
-            max_steps: (nodes + leaves).min(u32::MAX as usize) as u32,
+            root: tree.root(),
+            scene_scale: self.scene_scale(),
+            max_steps: (stats.nodes + stats.leaves).min(u32::MAX as usize) as u32,
         })
     }
 
@@ -257,10 +249,7 @@ impl PreparedScene {
     pub fn state_bytes(&self, method: Method) -> usize {
         let depth = match method {
             Method::Kd(_) => self.kd.as_ref().map(|k| k.tree.stats().depth),
-            Method::Wide(m) => match m.width() {
-                4 => self.wide4(m).ok().map(|t| t.stats().depth),
-                _ => self.wide8(m).ok().map(|t| t.stats().depth),
-            },
+            Method::Wide(m) => self.wide_tree(m).ok().map(|t| t.stats().depth),
             _ => None,
         };
         method.state_bytes(depth.unwrap_or(self.bvh.stats().depth), self.key_width().bytes())

@@ -11,7 +11,7 @@ mod begin;
 mod query;
 
 pub use crate::method::Query;
-pub use begin::{begin, begin_slab};
+pub use begin::{begin, begin_slab, for_each_ray};
 pub use query::QueryState;
 
 /// What a step leaves to do.

@@ -20,4 +20,4 @@ pub use kernel::{sort_keys, ChildHits, ChildKernel, FastKernel, ReferenceKernel}
 pub use memory::{WideMemory, WideSliceMemory};
 pub use node::{WideChild, WideNode, EMPTY_CHILD};
 #[cfg(feature = "alloc")]
-pub use tree::{WideBvh, WideStats};
+pub use tree::{WideBvh, WideStats, WideTree};

@@ -8,7 +8,7 @@ use super::node::WideChild;
 use crate::intersect::{BlockHits, NoPair, RayContext, TriangleHit, TriangleTest, BLOCK};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::{begin, QueryState, Step};
+use crate::traverse::{for_each_ray, QueryState, Step};
 use crate::{Hit, Ray};
 
 /// Stack entries: enough for `W - 1` postponed children on each of 63 levels, `W` up to 8.
@@ -213,19 +213,13 @@ pub fn trace_wide_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTe
     obs: &mut O,
 ) {
     let mut state = WideState::<W>::new(root.root);
-    for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
-        *hit = match begin::<T, NoPair>(ray, root.scene_scale, query) {
-            Some((ctx, mut q)) => {
-                state.restart(root.root);
-                let mut budget = root.max_steps;
-                while state.step::<M, T, K, O>(mem, &ctx, &mut q, obs) != Step::Done && budget > 0 {
-                    budget -= 1;
-                }
-                q.hit
-            }
-            None => Hit::MISS,
-        };
-    }
+    for_each_ray::<T, NoPair>(rays, hits, root.scene_scale, query, |ctx, q| {
+        state.restart(root.root);
+        let mut budget = root.max_steps;
+        while state.step::<M, T, K, O>(mem, ctx, q, obs) != Step::Done && budget > 0 {
+            budget -= 1;
+        }
+    });
 }
 
 /// Traces one ray over a `W`-wide tree; see [`trace_wide_batch`].

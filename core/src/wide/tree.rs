@@ -125,6 +125,42 @@ impl<const W: usize> WideBvh<W> {
     }
 }
 
+/// A wide tree of either width: what a prepared scene lends a wide method, so that one match
+/// picks the width a traversal is monomorphized for.
+#[derive(Clone, Copy, Debug)]
+pub enum WideTree<'a> {
+    /// Four children per node.
+    Four(&'a WideBvh<4>),
+    /// Eight children per node.
+    Eight(&'a WideBvh<8>),
+}
+
+impl WideTree<'_> {
+    /// Where traversal starts.
+    pub fn root(&self) -> WideChild {
+        match self {
+            WideTree::Four(t) => t.root(),
+            WideTree::Eight(t) => t.root(),
+        }
+    }
+
+    /// Shape figures.
+    pub fn stats(&self) -> WideStats {
+        match self {
+            WideTree::Four(t) => t.stats(),
+            WideTree::Eight(t) => t.stats(),
+        }
+    }
+
+    /// The canonical BVH2 id of a recorded reference ([`WideBvh::canonical_id`]).
+    pub fn canonical_id(&self, r: NodeRef) -> Option<u32> {
+        match self {
+            WideTree::Four(t) => t.canonical_id(r),
+            WideTree::Eight(t) => t.canonical_id(r),
+        }
+    }
+}
+
 /// Leaves below each canonical node.
 fn leaves_below(bvh: &Bvh2) -> Vec<u32> {
     let nodes = bvh.nodes();

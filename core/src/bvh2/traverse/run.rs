@@ -4,7 +4,7 @@ use crate::intersect::{RayContext, SlabPair, TriangleTest};
 use crate::key::Key;
 use crate::method::{Bvh2Method, Query};
 use crate::observe::Observer;
-use crate::traverse::{begin, QueryState, Step};
+use crate::traverse::{for_each_ray, QueryState, Step};
 use crate::{Hit, Ray};
 
 /// Where a traversal starts, with the scene constant every ray needs.
@@ -63,54 +63,33 @@ pub fn trace_batch<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
     match method {
         Bvh2Method::Stack => {
             let mut s = StackState::<false>::new(r);
-            for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+            for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
                 s.restart(r);
                 drive(&mut s, mem, ctx, q, obs, root.max_steps);
             });
         }
         Bvh2Method::StackDisjoint => {
             let mut s = StackState::<true>::new(r);
-            for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+            for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
                 s.restart(r);
                 drive(&mut s, mem, ctx, q, obs, root.max_steps);
             });
         }
-        Bvh2Method::ParentSibling => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+        Bvh2Method::ParentSibling => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
             drive(&mut ParentSiblingState::<K>::new(r), mem, ctx, q, obs, root.max_steps)
         }),
-        Bvh2Method::Uncle => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+        Bvh2Method::Uncle => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
             drive(&mut RegisterState::<K, UncleHops, false>::new(r), mem, ctx, q, obs, root.max_steps)
         }),
-        Bvh2Method::Hash => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+        Bvh2Method::Hash => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
             drive(&mut RegisterState::<K, PerfectHashLookup, false>::new(r), mem, ctx, q, obs, root.max_steps)
         }),
-        Bvh2Method::HashDisjoint => for_each_ray::<T>(rays, hits, root, query, |ctx, q| {
+        Bvh2Method::HashDisjoint => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
             drive(&mut RegisterState::<K, PerfectHashLookup, true>::new(r), mem, ctx, q, obs, root.max_steps)
         }),
-        Bvh2Method::HashResume => {
-            for_each_ray::<T>(rays, hits, root, query, |ctx, q| trace_pausing::<K, M, T, O>(mem, root, ctx, q, obs))
-        }
-    }
-}
-
-/// Sets up each ray ([`begin`]), lets `trace` answer it and stores the answer; a ray that
-/// [`begin`] turns away is a miss.
-#[inline(always)]
-fn for_each_ray<T: TriangleTest>(
-    rays: &[Ray],
-    hits: &mut [Hit],
-    root: TraceRoot,
-    query: Query,
-    mut trace: impl FnMut(&RayContext<T>, &mut QueryState),
-) {
-    for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
-        *hit = match begin::<T, SlabPair>(ray, root.scene_scale, query) {
-            Some((ctx, mut q)) => {
-                trace(&ctx, &mut q);
-                q.hit
-            }
-            None => Hit::MISS,
-        };
+        Bvh2Method::HashResume => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
+            trace_pausing::<K, M, T, O>(mem, root, ctx, q, obs)
+        }),
     }
 }
 

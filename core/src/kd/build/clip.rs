@@ -103,7 +103,7 @@ struct Polygon {
 
 impl Polygon {
     fn new(tri: &Triangle, cell: &Aabb) -> Self {
-        let mut scale = cell.min.abs().max(cell.max.abs()).max_element();
+        let mut scale = cell.max_abs();
         let mut buffers = [[[0.0; 3]; MAX_VERTICES]; 2];
         for (p, v) in buffers[0].iter_mut().zip(tri.v) {
             scale = scale.max(v.abs().max_element());

@@ -134,7 +134,7 @@ impl KdBuilder {
     /// scene far from the origin), so candidate planes `2m` from a bound are distinct floats.
     pub fn plane_margin(bounds: &Aabb) -> f32 {
         let extent = bounds.extent().max_element();
-        let scale = bounds.min.abs().max(bounds.max.abs()).max_element();
+        let scale = bounds.max_abs();
         f32::EPSILON * (32.0 * extent).max(4.0 * scale)
     }
 
