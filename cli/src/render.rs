@@ -4,12 +4,13 @@
 //! visited by `--method`, from its per-ray node enumeration), so methods can be compared by eye.
 
 use crate::args::{builder, check_input, check_output, load_scene, method, warn, Outcome, RenderArgs};
+use crate::bench::rays::{facing_normal, AoShape};
 use crate::bench::view::View;
 use crate::limits::{check_image, try_vec};
 use crate::progress::timed;
 use crate::trace::raster_rays;
 use glam::Vec3;
-use raytrail::conformance::rays::scene_epsilon;
+use raytrail::conformance::rng::Pcg32;
 use raytrail::core::method::{Method, Query};
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::scene::Scene;
@@ -147,19 +148,6 @@ fn backtracks_per_ray(
     Ok(counts)
 }
 
-/// The geometric normal of the hit triangle, turned to face the ray.
-fn facing_normal(scene: &Scene, ray: &Ray, hit: &Hit) -> Option<Vec3> {
-    if !hit.is_hit() {
-        return None;
-    }
-    let t = scene.triangles().get(hit.prim as usize)?;
-    let n = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).normalize_or_zero();
-    if n == Vec3::ZERO {
-        return None;
-    }
-    Some(if n.dot(ray.dir()) > 0.0 { -n } else { n })
-}
-
 /// Each pixel coloured by its hit triangle's facing normal (`0.5 + 0.5 n` as RGB), dimmed by the
 /// angle to the ray, so that shapes read as in a shaded image.
 fn normals_image(scene: &Scene, rays: &[Ray], hits: &[Hit]) -> Result<Vec<u8>, String> {
@@ -178,16 +166,9 @@ fn normals_image(scene: &Scene, rays: &[Ray], hits: &[Hit]) -> Result<Vec<u8>, S
     Ok(img)
 }
 
-/// A 64-bit mix (SplitMix64's finaliser): the random stream of the AO rays.
-fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// Ambient occlusion: from each hit point, `per_pixel` cosine-weighted rays over the facing
-/// hemisphere, a tenth of the scene's diagonal long; the pixel's grey is the share that escapes.
-/// Traced one row of pixels at a time.
+/// Ambient occlusion: from each hit point, `per_pixel` rays as the bench makes them
+/// ([`AoShape::push_rays`]), a tenth of the scene's diagonal long; the pixel's grey is the share
+/// that escapes. Traced one row of pixels at a time.
 fn ao_image(
     tracer: &Tracer<'_>,
     scene: &Scene,
@@ -196,9 +177,7 @@ fn ao_image(
     width: usize,
     per_pixel: usize,
 ) -> Result<Vec<u8>, String> {
-    let bounds = scene.bounds();
-    let eps = scene_epsilon(bounds);
-    let radius = (0.1 * bounds.extent().length()).max(4.0 * eps);
+    let shape = AoShape::of(scene, 0.1, per_pixel);
     let mut img = try_vec(rays.len() * 3, 0u8, "image bytes").map_err(|e| e.message().to_string())?;
     let mut ao_rays = Vec::with_capacity(width * per_pixel);
     let mut ao_hits = Vec::with_capacity(width * per_pixel);
@@ -206,19 +185,11 @@ fn ao_image(
         ao_rays.clear();
         let mut owners = Vec::with_capacity(width);
         for (col, (ray, hit)) in row_rays.iter().zip(row_hits).enumerate() {
-            let Some(n) = facing_normal(scene, ray, hit) else { continue };
-            let p = ray.origin() + ray.dir() * hit.t + n * eps;
-            let (t1, t2) = orthonormal(n);
-            let pixel = (row * width + col) as u64;
-            for s in 0..per_pixel as u64 {
-                let r = mix(pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ s.wrapping_add(0x5EED));
-                let (a, b) = ((r >> 40) as f32 / (1u64 << 24) as f32, (r & 0xFF_FFFF) as f32 / (1u64 << 24) as f32);
-                let (sin, cos) = (2.0 * std::f32::consts::PI * a).sin_cos();
-                let rad = b.sqrt();
-                let d = (t1 * (rad * cos) + t2 * (rad * sin) + n * (1.0 - b).max(0.0).sqrt()).normalize_or_zero();
-                ao_rays.push(Ray::new(p, if d == Vec3::ZERO { n } else { d }, 0.0, radius));
+            // Each pixel its own random stream, so the image does not depend on the row size.
+            let mut rng = Pcg32::new(RENDER_SEED, (row * width + col) as u64);
+            if shape.push_rays(scene, ray, hit, &mut rng, &mut ao_rays) {
+                owners.push(col);
             }
-            owners.push(col);
         }
         ao_hits.clear();
         ao_hits.resize(ao_rays.len(), Hit::MISS);
@@ -236,12 +207,8 @@ fn ao_image(
     Ok(img)
 }
 
-/// Two unit vectors perpendicular to `n` and each other.
-fn orthonormal(n: Vec3) -> (Vec3, Vec3) {
-    let a = if n.x.abs() > 0.9 { Vec3::Y } else { Vec3::X };
-    let t1 = n.cross(a).normalize();
-    (t1, n.cross(t1))
-}
+/// The random streams of the rendered ambient occlusion.
+const RENDER_SEED: u64 = 0x5EED;
 
 /// The heat map: nodes visited on a log scale from dark blue (none) through cyan, green and yellow
 /// to red (`max`).

@@ -15,7 +15,7 @@ mod measure;
 pub mod options;
 mod peers;
 mod plot;
-mod rays;
+pub(crate) mod rays;
 mod report;
 mod table;
 mod target;

@@ -106,26 +106,57 @@ pub fn primary_rays(scene: &Scene, view: View, width: u32, height: u32) -> Vec<R
 /// (unit length), over `t` in `[0, AO_RADIUS * diagonal]`. The random stream of each primary ray
 /// is keyed by its index, so its rays do not change when other rays start hitting or missing.
 pub fn ambient_occlusion(rays: &[Ray], hits: &[Hit], scene: &Scene, per_hit: usize, seed: u64) -> Vec<Ray> {
-    let bounds = scene.bounds();
-    let eps = scene_epsilon(bounds);
-    let radius = (AO_RADIUS * bounds.extent().length()).max(eps * 4.0);
+    let shape = AoShape::of(scene, AO_RADIUS, per_hit);
     let mut out = Vec::with_capacity(hits.iter().filter(|h| h.is_hit()).count() * per_hit);
     for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-        let Some(p) = hit_point(ray, hit) else { continue };
-        let Some(t) = scene.triangles().get(hit.prim as usize) else { continue };
-        let mut n = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).normalize_or_zero();
-        if n == Vec3::ZERO {
-            continue;
-        }
-        if n.dot(ray.dir()) > 0.0 {
-            n = -n;
-        }
-        let mut rng = Pcg32::new(seed, i as u64);
-        for _ in 0..per_hit {
-            out.push(Ray::new(p + n * eps, cosine_direction(n, rng.in_unit_disk()), 0.0, radius));
-        }
+        shape.push_rays(scene, ray, hit, &mut Pcg32::new(seed, i as u64), &mut out);
     }
     out
+}
+
+/// How ambient-occlusion rays are made from a hit: how far they go, how far off the surface they
+/// start, how many per hit.
+#[derive(Clone, Copy, Debug)]
+pub struct AoShape {
+    /// Ray length.
+    pub radius: f32,
+    /// Offset of the origin along the normal ([`scene_epsilon`]).
+    pub eps: f32,
+    /// Rays per hit.
+    pub per_hit: usize,
+}
+
+impl AoShape {
+    /// Rays of `radius_fraction` of `scene`'s diagonal (at least four epsilons), `per_hit` a hit.
+    pub fn of(scene: &Scene, radius_fraction: f32, per_hit: usize) -> AoShape {
+        let bounds = scene.bounds();
+        let eps = scene_epsilon(bounds);
+        AoShape { radius: (radius_fraction * bounds.extent().length()).max(eps * 4.0), eps, per_hit }
+    }
+
+    /// Pushes the rays of one closest hit onto `out` (see [`ambient_occlusion`]); returns whether
+    /// it pushed any (not for a miss, a non-finite hit or a zero-area triangle).
+    pub fn push_rays(&self, scene: &Scene, ray: &Ray, hit: &Hit, rng: &mut Pcg32, out: &mut Vec<Ray>) -> bool {
+        let (Some(p), Some(n)) = (hit_point(ray, hit), facing_normal(scene, ray, hit)) else { return false };
+        for _ in 0..self.per_hit {
+            out.push(Ray::new(p + n * self.eps, cosine_direction(n, rng.in_unit_disk()), 0.0, self.radius));
+        }
+        true
+    }
+}
+
+/// The geometric normal of the hit triangle, turned to face the ray; `None` for a miss or a
+/// zero-area triangle.
+pub fn facing_normal(scene: &Scene, ray: &Ray, hit: &Hit) -> Option<Vec3> {
+    if !hit.is_hit() {
+        return None;
+    }
+    let t = scene.triangles().get(hit.prim as usize)?;
+    let n = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).normalize_or_zero();
+    if n == Vec3::ZERO {
+        return None;
+    }
+    Some(if n.dot(ray.dir()) > 0.0 { -n } else { n })
 }
 
 /// The hit point of a closest hit (evaluated in `f64`, rounded once), or `None` for a miss or a
