@@ -22,6 +22,13 @@ pub enum Difference {
         /// Whether the method did.
         got: bool,
     },
+    /// A stream method's packet leaf list lacks the leaf holding the ray's reference closest hit.
+    IncompleteLeafList {
+        /// The leaf (canonical id) that holds the reference hit.
+        leaf: u32,
+        /// The ray's enumeration: its packet, then the packet's leaves.
+        got: Vec<u32>,
+    },
     /// Node enumerations differ.
     Enumeration {
         /// The reference's visited nodes (canonical ids).
@@ -104,6 +111,10 @@ impl fmt::Display for Mismatch {
                 writeln!(f, "    got      hit {got:?} (t bits {:#010x})", got.t.to_bits())
             }
             Difference::Occlusion { expected, got } => writeln!(f, "    expected occluded={expected}, got {got}"),
+            Difference::IncompleteLeafList { leaf, got } => {
+                writeln!(f, "    the reference hit is in leaf {leaf}, which the packet's leaf list lacks:")?;
+                write_seq(f, self.method.name(), got, 0)
+            }
             Difference::Enumeration { expected, got } => {
                 let at = parting_point(expected, got).unwrap_or(0);
                 writeln!(f, "    enumerations part at position {at}:")?;
@@ -291,6 +302,56 @@ pub fn check_ray_set<B: Trace>(
         all.extend(compare(ctx, rays, &outcomes));
     }
     Ok(all)
+}
+
+/// The completeness of a stream method's leaf lists: every ray whose reference closest hit (the
+/// stack method's) lies in leaf `leaf_of_prim[prim]` must have that leaf in its enumeration
+/// (its packet, then the packet's leaves).
+pub fn check_complete(
+    ctx: Context<'_>,
+    rays: &[Ray],
+    method: Method,
+    reference: &[Hit],
+    enumerations: &[Vec<u32>],
+    leaf_of_prim: &[u32],
+) -> Vec<Mismatch> {
+    let mut out = Vec::new();
+    for (i, hit) in reference.iter().enumerate() {
+        if !hit.is_hit() {
+            continue;
+        }
+        let leaf = leaf_of_prim.get(hit.prim as usize).copied().unwrap_or(u32::MAX);
+        let got = enumerations.get(i).map_or(&[][..], Vec::as_slice);
+        if !got.get(1..).unwrap_or(&[]).contains(&leaf) {
+            out.push(Mismatch {
+                scene: ctx.scene.to_string(),
+                ray_set: ctx.ray_set.to_string(),
+                backend: ctx.backend.to_string(),
+                method,
+                reference: Method::Bvh2(Bvh2Method::Stack),
+                query: Query::Closest,
+                ray_index: i,
+                ray: rays[i],
+                difference: Difference::IncompleteLeafList { leaf, got: got.to_vec() },
+            });
+        }
+    }
+    out
+}
+
+/// The canonical id of the leaf holding each primitive of `bvh`.
+pub fn leaf_of_prim(bvh: &raytrail_core::bvh2::Bvh2) -> Vec<u32> {
+    let mut out = vec![u32::MAX; bvh.prim_order().len()];
+    for (id, node) in bvh.nodes().iter().enumerate() {
+        if let raytrail_core::bvh2::NodeKind::Leaf { first, count } = node.kind {
+            for &p in &bvh.prim_order()[first as usize..(first + count) as usize] {
+                if let Some(slot) = out.get_mut(p as usize) {
+                    *slot = id as u32;
+                }
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -7,7 +7,8 @@ use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use raytrail_core::kd::traverse::packets::packets;
 use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, RestartPolicy, PACKET_WIDTH};
 use raytrail_core::key::KeyWidth;
-use raytrail_core::method::{KdMethod, Method, Query};
+use raytrail_core::method::{KdMethod, Method, Query, StreamMethod};
+use raytrail_core::stream::{trace_stream, FrustumCull, Serial};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
@@ -103,6 +104,39 @@ impl SerialBackend {
     }
 }
 
+impl SerialBackend {
+    /// The stream pipeline with every stage serial, the reference frustum test and one triangle
+    /// at a time, always counting.
+    fn stream(
+        scene: &PreparedScene,
+        method: StreamMethod,
+        opts: &TraceOptions,
+        rays: &[Ray],
+        hits: &mut [Hit],
+    ) -> Result<Report, Error> {
+        let s = scene.stream_scene(method)?;
+        let start = Instant::now();
+        let enumerate = opts.record == Record::Enumerations;
+        let out = match opts.triangle_test {
+            TriangleTestKind::Watertight => trace_stream::<_, FrustumCull, Watertight, ReferenceKernel>(
+                &Serial, &s, rays, hits, opts.query, &opts.stream, true, enumerate,
+            ),
+            TriangleTestKind::MollerTrumbore => trace_stream::<_, FrustumCull, MollerTrumbore, ReferenceKernel>(
+                &Serial, &s, rays, hits, opts.query, &opts.stream, true, enumerate,
+            ),
+        }?;
+        let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());
+        report.counters = (opts.record != Record::Nothing).then(|| {
+            let mut c = out.counters.unwrap_or_default();
+            c.rays = rays.len() as u64;
+            c
+        });
+        report.enumerations = out.enumerations;
+        report.stream = Some(out.stats);
+        Ok(report)
+    }
+}
+
 impl Trace for SerialBackend {
     type Prepared = Arc<PreparedScene>;
 
@@ -110,9 +144,9 @@ impl Trace for SerialBackend {
         "serial"
     }
 
-    /// Every BVH2, kd and wide-BVH method.
+    /// Every BVH2, kd, wide-BVH and stream method.
     fn supports(&self, method: Method) -> bool {
-        matches!(method, Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_))
+        matches!(method, Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_) | Method::Stream(_))
     }
 
     fn prepare(&self, scene: Arc<PreparedScene>) -> Result<Arc<PreparedScene>, Error> {
@@ -128,6 +162,9 @@ impl Trace for SerialBackend {
     ) -> Result<Report, Error> {
         check_buffers(rays, hits)?;
         scene.check_prepared(opts.method)?;
+        if let Method::Stream(m) = opts.method {
+            return Self::stream(scene, m, opts, rays, hits);
+        }
         let start = Instant::now();
         let traced = match opts.triangle_test {
             TriangleTestKind::Watertight => Self::trace_all::<Watertight>(scene, opts.method, opts.query, rays)?,

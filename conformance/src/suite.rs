@@ -8,7 +8,7 @@
 //! the [`SerialBackend`] ([`compare_backends`](crate::check::compare_backends)). A method the
 //! backend does not support fails the case: the suite never passes over a method in silence.
 
-use crate::check::{check_against, Context, Mismatch};
+use crate::check::{check_against, check_complete, leaf_of_prim, Context, Mismatch};
 use crate::paths::{load_mesh_scene, scenes_dir};
 use crate::rays::{ray_sets, RaySetSize};
 use crate::reference::SerialBackend;
@@ -17,7 +17,7 @@ use raytrail_core::bvh2::{Bvh2, SahBuilder};
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Bvh2Method, Method};
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::trace::{Trace, TraceOptions};
+use raytrail_core::trace::{Record, Trace, TraceOptions};
 use raytrail_core::{Hit, Ray};
 use std::any::Any;
 use std::fmt::Display;
@@ -167,11 +167,20 @@ pub fn check_scene<B: Trace>(
     let sets = ray_sets(&named.scene, size, &mut trace_closest);
     let mut mismatches: Vec<Mismatch> = Vec::new();
     let mut checked = 0;
+    let leaves = leaf_of_prim(&serial_scene.bvh);
     for set in &sets {
         let ctx = Context { scene: &named.name, ray_set: set.kind.name(), backend: backend.name() };
         mismatches.extend(
             check_against(&serial, &serial_scene, backend, &scene, ctx, &set.rays, &Method::ALL).expect("trace"),
         );
+        let reference = trace_closest(&set.rays);
+        for method in Method::STREAM {
+            let opts = TraceOptions::new(method).record(Record::Enumerations);
+            let mut hits = vec![Hit::MISS; set.rays.len()];
+            let report = backend.trace(&scene, &set.rays, &opts, &mut hits).expect("trace");
+            let enumerations = report.enumerations.unwrap_or_default();
+            mismatches.extend(check_complete(ctx, &set.rays, method, &reference, &enumerations, &leaves));
+        }
         checked += set.rays.len();
     }
     assert!(checked > 0, "{}: no rays were checked", named.name);

@@ -64,6 +64,13 @@ pub enum Error {
         /// What cannot run it.
         by: &'static str,
     },
+    /// A parameter is out of its range.
+    InvalidParameter {
+        /// The parameter.
+        name: &'static str,
+        /// What it must be.
+        why: &'static str,
+    },
     /// A backend's device failed or lacks something (no adapter, a missing feature, a limit).
     #[cfg(feature = "alloc")]
     Device {
@@ -97,6 +104,7 @@ impl fmt::Display for Error {
                 write!(f, "method {method} needs {missing}, which the scene was not prepared with")
             }
             Error::Unsupported { method, by } => write!(f, "method {method} is not supported by {by}"),
+            Error::InvalidParameter { name, why } => write!(f, "invalid {name}: {why}"),
             #[cfg(feature = "alloc")]
             Error::Device { backend, detail } => write!(f, "{backend} backend: {detail}"),
         }

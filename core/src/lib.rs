@@ -31,6 +31,8 @@ pub mod prepared;
 #[cfg(feature = "alloc")]
 pub mod scene;
 #[cfg(feature = "alloc")]
+pub mod stream;
+#[cfg(feature = "alloc")]
 pub mod trace;
 pub mod traverse;
 pub mod wide;
@@ -39,4 +41,4 @@ pub use error::Error;
 pub use geometry::{Aabb, Hit, Ray};
 /// The vector library of the public API, re-exported so callers use the same version.
 pub use glam;
-pub use method::{Bvh2Method, KdMethod, Method, Query, WideMethod};
+pub use method::{Bvh2Method, KdMethod, Method, Query, StreamMethod, WideMethod};

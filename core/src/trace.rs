@@ -3,6 +3,7 @@
 use crate::method::{Method, Query};
 use crate::observe::Counters;
 use crate::prepared::PreparedScene;
+use crate::stream::{StreamParams, StreamStats};
 use crate::{Error, Hit, Ray};
 use alloc::sync::Arc;
 use alloc::vec::Vec;
@@ -49,6 +50,8 @@ pub struct TraceOptions {
     pub triangle_test: TriangleTestKind,
     /// What to record.
     pub record: Record,
+    /// Parameters of the stream methods (ignored by the others).
+    pub stream: StreamParams,
 }
 
 impl TraceOptions {
@@ -59,6 +62,7 @@ impl TraceOptions {
             query: Query::Closest,
             triangle_test: TriangleTestKind::Watertight,
             record: Record::Nothing,
+            stream: StreamParams::default(),
         }
     }
 
@@ -79,6 +83,12 @@ impl TraceOptions {
         self.record = record;
         self
     }
+
+    /// The same options with `params` for the stream methods.
+    pub fn stream(mut self, params: StreamParams) -> Self {
+        self.stream = params;
+        self
+    }
 }
 
 /// What a batch cost, and what was recorded: a field is `None` exactly when it was not asked for.
@@ -94,12 +104,14 @@ pub struct Report {
     pub counters: Option<Counters>,
     /// Per-ray node enumerations ([`Record::Enumerations`]).
     pub enumerations: Option<Vec<Vec<u32>>>,
+    /// A stream method's working figures and stage times (stream methods only, always).
+    pub stream: Option<StreamStats>,
 }
 
 impl Report {
     /// A report of `rays` rays traced in `seconds`, recording nothing.
     pub fn new(rays: usize, seconds: f64) -> Self {
-        Self { rays, seconds, counters: None, enumerations: None }
+        Self { rays, seconds, counters: None, enumerations: None, stream: None }
     }
 
     /// Millions of rays per second.

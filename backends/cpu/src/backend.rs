@@ -54,9 +54,9 @@ impl Trace for CpuBackend {
         "cpu"
     }
 
-    /// Every BVH2, kd and wide-BVH method.
+    /// Every BVH2, kd, wide-BVH and stream method.
     fn supports(&self, method: Method) -> bool {
-        matches!(method, Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_))
+        matches!(method, Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_) | Method::Stream(_))
     }
 
     fn prepare(&self, scene: Arc<PreparedScene>) -> Result<CpuScene, Error> {
@@ -70,6 +70,19 @@ impl Trace for CpuBackend {
         }
         // Fail before timing if the scene lacks what the method needs.
         scene.0.check_prepared(opts.method)?;
+        if let Method::Stream(m) = opts.method {
+            // The batch as a whole: its stages are the parallel part.
+            let start = Instant::now();
+            let out = self.install(|| crate::stream::trace(&scene.0, m, opts, rays, hits))?;
+            let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());
+            report.counters = out.counters.map(|mut c| {
+                c.rays = rays.len() as u64;
+                c
+            });
+            report.enumerations = out.enumerations;
+            report.stream = Some(out.stats);
+            return Ok(report);
+        }
         let mut enumerations: Vec<Vec<u32>> =
             if opts.record == Record::Enumerations { vec![Vec::new(); rays.len()] } else { Vec::new() };
         let start = Instant::now();

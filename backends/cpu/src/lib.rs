@@ -15,6 +15,7 @@ mod bvh2;
 mod chunk;
 mod kd;
 pub mod ploc;
+mod stream;
 mod wide;
 
 pub use backend::{CpuBackend, CpuScene};

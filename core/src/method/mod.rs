@@ -9,11 +9,13 @@
 mod bvh2;
 mod kd;
 mod query;
+mod stream;
 mod wide;
 
 pub use bvh2::Bvh2Method;
 pub use kd::KdMethod;
 pub use query::Query;
+pub use stream::StreamMethod;
 pub use wide::{Collapse, WideMethod};
 
 use crate::Error;
@@ -30,6 +32,8 @@ pub enum Method {
     Kd(KdMethod),
     /// A method of a wide BVH.
     Wide(WideMethod),
+    /// A ray-stream method: the whole batch sorted into packets and traced by frustums.
+    Stream(StreamMethod),
 }
 
 /// The acceleration structure a method traverses.
@@ -42,6 +46,8 @@ pub enum Structure {
     Kd,
     /// A wide BVH collapsed from the binary one.
     Wide,
+    /// The 8-wide BVH stored level by level, traversed by packet frustums.
+    Levels,
 }
 
 impl Method {
@@ -78,18 +84,23 @@ impl Method {
         out
     };
 
-    /// Every method: the BVH2 methods, the kd methods, then the wide methods.
-    pub const ALL: [Method; Method::BVH2.len() + Method::KD.len() + Method::WIDE.len()] = {
-        let (b, k) = (Method::BVH2.len(), Method::KD.len());
-        let mut out = [Method::Bvh2(Bvh2Method::Stack); Method::BVH2.len() + Method::KD.len() + Method::WIDE.len()];
+    /// The stream methods, as [`Method`]s.
+    pub const STREAM: [Method; StreamMethod::ALL.len()] = [Method::Stream(StreamMethod::Frustum8)];
+
+    /// Every method: the BVH2 methods, the kd methods, the wide methods, then the stream methods.
+    pub const ALL: [Method; Method::BVH2.len() + Method::KD.len() + Method::WIDE.len() + Method::STREAM.len()] = {
+        let (b, k, w) = (Method::BVH2.len(), Method::KD.len(), Method::WIDE.len());
+        let mut out = [Method::Bvh2(Bvh2Method::Stack); Method::BVH2.len() + Method::KD.len() + Method::WIDE.len() + Method::STREAM.len()];
         let mut i = 0;
         while i < out.len() {
             out[i] = if i < b {
                 Method::BVH2[i]
             } else if i < b + k {
                 Method::KD[i - b]
-            } else {
+            } else if i < b + k + w {
                 Method::WIDE[i - b - k]
+            } else {
+                Method::STREAM[i - b - k - w]
             };
             i += 1;
         }
@@ -102,6 +113,7 @@ impl Method {
             Method::Bvh2(_) => Structure::Bvh2,
             Method::Kd(_) => Structure::Kd,
             Method::Wide(_) => Structure::Wide,
+            Method::Stream(_) => Structure::Levels,
         }
     }
 
@@ -111,6 +123,7 @@ impl Method {
             Method::Bvh2(m) => m.name(),
             Method::Kd(m) => m.name(),
             Method::Wide(m) => m.name(),
+            Method::Stream(m) => m.name(),
         }
     }
 
@@ -123,11 +136,13 @@ impl Method {
     /// (for kd methods the enumeration is the sequence of leaves: restarts revisit inner nodes).
     /// A wide method is its own reference: each tree is its own, and its enumeration is checked
     /// against the scalar reference traversal of the same tree (the serial backend's) instead.
+    /// So is a stream method, whose enumeration is its packets' leaf lists.
     pub fn reference(self) -> Method {
         match self {
             Method::Bvh2(m) => Method::Bvh2(m.reference()),
             Method::Kd(_) => Method::Kd(KdMethod::Stack),
             Method::Wide(m) => Method::Wide(m),
+            Method::Stream(m) => Method::Stream(m),
         }
     }
 
@@ -140,6 +155,7 @@ impl Method {
             Method::Bvh2(m) => m.state_bytes(depth, key_bytes),
             Method::Kd(m) => m.state_bytes(depth),
             Method::Wide(m) => m.state_bytes(depth),
+            Method::Stream(m) => m.state_bytes(),
         }
     }
 
@@ -163,6 +179,14 @@ impl Method {
     pub fn wide(self) -> Option<WideMethod> {
         match self {
             Method::Wide(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The stream method, if this is one.
+    pub fn stream(self) -> Option<StreamMethod> {
+        match self {
+            Method::Stream(m) => Some(m),
             _ => None,
         }
     }
@@ -217,6 +241,20 @@ impl TryFrom<Method> for WideMethod {
     }
 }
 
+impl From<StreamMethod> for Method {
+    fn from(m: StreamMethod) -> Method {
+        Method::Stream(m)
+    }
+}
+
+impl TryFrom<Method> for StreamMethod {
+    type Error = Error;
+    /// The stream method, or [`Error::Unsupported`] naming a method of another structure.
+    fn try_from(m: Method) -> Result<StreamMethod, Error> {
+        m.stream().ok_or(Error::Unsupported { method: m.name(), by: "a ray-stream traversal" })
+    }
+}
+
 impl TryFrom<Method> for KdMethod {
     type Error = Error;
     /// The kd method, or [`Error::Unsupported`] naming a method of another structure.
@@ -241,7 +279,7 @@ mod tests {
             assert_eq!(Method::from_name(m.name()), Some(m));
         }
         assert_eq!(Method::from_name("nope"), None);
-        assert_eq!(Method::BVH2.len() + Method::KD.len() + Method::WIDE.len(), Method::ALL.len());
+        assert_eq!(Method::BVH2.len() + Method::KD.len() + Method::WIDE.len() + Method::STREAM.len(), Method::ALL.len());
         assert_eq!((Method::ALL[0], Method::ALL[7]), (Method::Bvh2(Bvh2Method::Stack), Method::Kd(KdMethod::Stack)));
     }
 

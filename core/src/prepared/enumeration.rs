@@ -28,6 +28,10 @@ impl PreparedScene {
                 let tree = self.wide_tree(m)?;
                 Ok(refs.into_iter().map(|r| tree.canonical_id(r).unwrap_or(UNKNOWN_NODE)).collect())
             }
+            // A stream method's enumeration is made by its pipeline (its packets' leaf lists).
+            Method::Stream(m) => {
+                Err(Error::Unsupported { method: m.name(), by: "per-ray recordings (its pipeline enumerates)" })
+            }
         }
     }
 }

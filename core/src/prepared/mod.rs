@@ -10,7 +10,8 @@ use crate::hash::{keys_to_hash, HashCoverage, HashShape, HashStats, PerfectHash}
 use crate::kd::traverse::KdRoot;
 use crate::kd::{KdBuilder, KdSliceMemory, KdTree};
 use crate::key::KeyWidth;
-use crate::method::{Bvh2Method, Method, Structure, WideMethod};
+use crate::method::{Bvh2Method, Method, StreamMethod, Structure, WideMethod};
+use crate::stream::{LevelBvh, StreamScene};
 use crate::scene::Scene;
 use crate::wide::traverse::WideRoot;
 use crate::wide::{WideBvh, WideTree};
@@ -30,6 +31,8 @@ pub struct PrepareTimings {
     pub kd: f64,
     /// The wide trees.
     pub wide: f64,
+    /// The level-order tree of the stream methods.
+    pub levels: f64,
 }
 
 /// A kd-tree with the triangles its leaves reference.
@@ -75,13 +78,15 @@ pub struct PreparedScene {
     pub wide8: Option<WideBvh<8>>,
     /// The 4-wide tree with every second level removed ([`WideMethod::Bvh4Naive`]).
     pub wide4_naive: Option<WideBvh<4>>,
+    /// The 8-wide tree laid out level by level ([`StreamMethod::Frustum8`]).
+    pub levels: Option<LevelBvh>,
     /// Time spent on each part.
     pub timings: PrepareTimings,
 }
 
 /// Seconds since `start` (a value this function returned), or a start mark when `None`.
 #[cfg(feature = "std")]
-fn seconds_since(start: Option<f64>) -> f64 {
+pub(crate) fn seconds_since(start: Option<f64>) -> f64 {
     use std::time::{SystemTime, UNIX_EPOCH};
     let now = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64());
     start.map_or(now, |s| now - s)
@@ -89,7 +94,7 @@ fn seconds_since(start: Option<f64>) -> f64 {
 
 /// Without `std` there is no clock: every timing is zero.
 #[cfg(not(feature = "std"))]
-fn seconds_since(_start: Option<f64>) -> f64 {
+pub(crate) fn seconds_since(_start: Option<f64>) -> f64 {
     0.0
 }
 
@@ -141,7 +146,18 @@ impl PreparedScene {
                 .transpose()?,
         );
         timings.wide = seconds_since(Some(t4));
-        Ok(PreparedScene { bvh, uncles, parents, hash, full_hash, kd, wide4, wide8, wide4_naive, timings })
+        let t5 = seconds_since(None);
+        let levels = if methods.contains(&Method::Stream(StreamMethod::Frustum8)) {
+            let bounds = bvh.nodes()[0].bounds;
+            Some(match &wide8 {
+                Some(w) => LevelBvh::new(w, &bounds)?,
+                None => LevelBvh::new(&WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse())?, &bounds)?,
+            })
+        } else {
+            None
+        };
+        timings.levels = seconds_since(Some(t5));
+        Ok(PreparedScene { bvh, uncles, parents, hash, full_hash, kd, wide4, wide8, wide4_naive, levels, timings })
     }
 
     /// Key width the tree's depth needs.
@@ -234,6 +250,12 @@ impl PreparedScene {
         })
     }
 
+    /// What `method` traverses: the level-order tree with the scene box and scale.
+    pub fn stream_scene(&self, method: StreamMethod) -> Result<StreamScene<'_>, Error> {
+        let tree = self.levels.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "the level-order tree" })?;
+        Ok(StreamScene { tree, bounds: self.bvh.nodes()[0].bounds, scene_scale: self.scene_scale() })
+    }
+
     /// Checks that the scene holds everything `method` reads, so a backend fails before it
     /// starts (and before it times anything).
     pub fn check_prepared(&self, method: Method) -> Result<(), Error> {
@@ -241,6 +263,7 @@ impl PreparedScene {
             Method::Bvh2(m) => self.memory(m).map(|_| ()),
             Method::Kd(_) => self.kd_memory().map(|_| ()),
             Method::Wide(m) => self.wide_root(m).map(|_| ()),
+            Method::Stream(m) => self.stream_scene(m).map(|_| ()),
         }
     }
 

@@ -141,7 +141,7 @@ impl<const W: usize> WideState<W> {
 /// culled is refused by the offer instead (it is farther, or tied with a larger id), so the answer
 /// and the events are those of one triangle at a time.
 #[inline(always)]
-fn leaf<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
+pub(crate) fn leaf<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
     mem: &M,
     first: u32,
     count: u32,

@@ -1,0 +1,48 @@
+//! The stream method on the CPU: the core's pipeline with its stages mapped over rayon, the fast
+//! leaf test (four triangles at once).
+
+use rayon::prelude::*;
+use raytrail_core::intersect::{MollerTrumbore, Watertight};
+use raytrail_core::method::StreamMethod;
+use raytrail_core::prepared::PreparedScene;
+use raytrail_core::stream::{trace_stream, FrustumCull, Parallel, StreamOutput};
+use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
+use raytrail_core::wide::FastKernel;
+use raytrail_core::{Error, Hit, Ray};
+
+/// Stage items on rayon's current pool. Small stages stay on the calling thread, where splitting
+/// would cost more than the work.
+struct Rayon;
+
+/// Below this many items a stage runs serially.
+const SERIAL_BELOW: usize = 512;
+
+impl Parallel for Rayon {
+    fn map<T: Send>(&self, n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+        if n < SERIAL_BELOW {
+            (0..n).map(f).collect()
+        } else {
+            (0..n).into_par_iter().with_min_len(64).map(f).collect()
+        }
+    }
+}
+
+/// Traces the whole batch (call inside the backend's pool).
+pub(crate) fn trace(
+    scene: &PreparedScene,
+    method: StreamMethod,
+    opts: &TraceOptions,
+    rays: &[Ray],
+    hits: &mut [Hit],
+) -> Result<StreamOutput, Error> {
+    let s = scene.stream_scene(method)?;
+    let (count, enumerate) = (opts.record != Record::Nothing, opts.record == Record::Enumerations);
+    match opts.triangle_test {
+        TriangleTestKind::Watertight => trace_stream::<_, FrustumCull, Watertight, FastKernel>(
+            &Rayon, &s, rays, hits, opts.query, &opts.stream, count, enumerate,
+        ),
+        TriangleTestKind::MollerTrumbore => trace_stream::<_, FrustumCull, MollerTrumbore, FastKernel>(
+            &Rayon, &s, rays, hits, opts.query, &opts.stream, count, enumerate,
+        ),
+    }
+}

@@ -1,0 +1,19 @@
+//! How a stage maps over its items.
+
+/// How a stage maps over its items: one after another ([`Serial`]), or in parallel where a
+/// backend supplies a pool (the CPU backend's rayon). Every stage's result is the same either way,
+/// which is what lets the serial reference check a parallel backend array by array.
+pub trait Parallel: Sync {
+    /// `f(0), f(1), ..., f(n - 1)`, in that order.
+    fn map<T: Send>(&self, n: usize, f: impl Fn(usize) -> T + Sync + Send) -> alloc::vec::Vec<T>;
+}
+
+/// Every item on the calling thread.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Serial;
+
+impl Parallel for Serial {
+    fn map<T: Send>(&self, n: usize, f: impl Fn(usize) -> T + Sync + Send) -> alloc::vec::Vec<T> {
+        (0..n).map(f).collect()
+    }
+}

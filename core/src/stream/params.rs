@@ -1,0 +1,59 @@
+use crate::Error;
+
+/// The stream method's parameters (Garanzha & Loop 2010, Sec. 3.1 and 5.1). Compared and hashed
+/// by the bits of the fractions.
+#[derive(Clone, Copy, Debug)]
+pub struct StreamParams {
+    /// Origin cell size as a fraction of the scene box's diagonal (the paper's UserCellFraction;
+    /// 0.004 by default, its robust choice).
+    pub origin_cell_fraction: f32,
+    /// Direction cell size as a fraction of a cube face's side: directions are quantized on the
+    /// face of the unit cube they point through, so the rays of one cell share their dominant
+    /// axis (the frustum's). 1/128 by default.
+    pub direction_cell_fraction: f32,
+    /// Most rays per packet (the paper's MaxSize; 256 by default).
+    pub max_packet: u32,
+}
+
+impl Default for StreamParams {
+    fn default() -> Self {
+        Self { origin_cell_fraction: 0.004, direction_cell_fraction: 1.0 / 128.0, max_packet: 256 }
+    }
+}
+
+impl StreamParams {
+    /// Checks that the cell fractions are positive and finite and the packet size is at least 1.
+    pub fn check(&self) -> Result<(), Error> {
+        let fraction_ok = |f: f32| f.is_finite() && f > 0.0;
+        if !fraction_ok(self.origin_cell_fraction) {
+            return Err(Error::InvalidParameter { name: "origin cell fraction", why: "must be positive and finite" });
+        }
+        if !fraction_ok(self.direction_cell_fraction) {
+            return Err(Error::InvalidParameter { name: "direction cell fraction", why: "must be positive and finite" });
+        }
+        if self.max_packet == 0 {
+            return Err(Error::InvalidParameter { name: "packet size", why: "must be at least 1" });
+        }
+        Ok(())
+    }
+}
+
+impl StreamParams {
+    fn bits(&self) -> (u32, u32, u32) {
+        (self.origin_cell_fraction.to_bits(), self.direction_cell_fraction.to_bits(), self.max_packet)
+    }
+}
+
+impl PartialEq for StreamParams {
+    fn eq(&self, other: &Self) -> bool {
+        self.bits() == other.bits()
+    }
+}
+
+impl Eq for StreamParams {}
+
+impl core::hash::Hash for StreamParams {
+    fn hash<H: core::hash::Hasher>(&self, state: &mut H) {
+        self.bits().hash(state);
+    }
+}

@@ -1,0 +1,232 @@
+//! The four stages end to end (Garanzha & Loop 2010, Fig. 1): sort the rays into packets, build a
+//! frustum per packet, traverse the tree breadth-first with the frustums, intersect each packet's
+//! rays with its leaves. Written once over [`Parallel`], so the serial reference and a parallel
+//! backend run the same code and produce the same arrays.
+
+use super::exec::Parallel;
+use super::frustum::{Frustum, FrustumTest};
+use super::levels::LevelBvh;
+use super::localized::intersect_packet;
+use super::ray_hash::RayGrid;
+use super::sort::{packets, sort_by_key};
+use super::traverse::{traverse, LeafLists};
+use super::StreamParams;
+use crate::intersect::TriangleTest;
+use crate::method::Query;
+use crate::observe::{Counters, NoObserver, Observer};
+use crate::prepared::seconds_since;
+use crate::wide::ChildKernel;
+use crate::{Aabb, Error, Hit, Ray};
+use alloc::vec;
+use alloc::vec::Vec;
+
+/// Seconds per stage (zero without the `std` feature's clock).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageSeconds {
+    /// Hashing, sorting and packet decomposition.
+    pub sort: f64,
+    /// Frustum creation.
+    pub frustums: f64,
+    /// Breadth-first traversal.
+    pub traversal: f64,
+    /// Localized intersection, and the hits put back in ray order.
+    pub intersection: f64,
+}
+
+/// What a stream trace did: the paper's working figures (its Table 1) and stage times.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StreamStats {
+    /// Packets (frustums).
+    pub packets: usize,
+    /// Frustums with at least one ray that can hit anything.
+    pub active_frustums: usize,
+    /// Traversal queue length at the start of each level, then the final (leaf) queue's.
+    pub queue_sizes: Vec<u32>,
+    /// Leaf references over all frustums (the paper's LS; `packets` is its FS).
+    pub leaf_refs: usize,
+    /// Frustum-box tests.
+    pub box_tests: u64,
+    /// Peak bytes of the working arrays (keys, order, packet bounds, frustums, two queues).
+    pub working_bytes: usize,
+    /// Time per stage.
+    pub seconds: StageSeconds,
+}
+
+/// The first three stages' output: everything intersection needs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StreamPlan {
+    /// Each ray's key.
+    pub keys: Vec<u32>,
+    /// The rays in sorted order (indices).
+    pub order: Vec<u32>,
+    /// Packet bounds in `order`: packet `p` is `bounds[p]..bounds[p + 1]`.
+    pub packets: Vec<u32>,
+    /// One frustum per packet.
+    pub frustums: Vec<Frustum>,
+    /// Each frustum's leaves.
+    pub lists: LeafLists,
+}
+
+impl StreamPlan {
+    /// Number of packets.
+    pub fn packet_count(&self) -> usize {
+        self.packets.len().saturating_sub(1)
+    }
+
+    /// The ray indices of packet `p`.
+    pub fn packet(&self, p: usize) -> &[u32] {
+        &self.order[self.packets[p] as usize..self.packets[p + 1] as usize]
+    }
+
+    /// The leaves (node indices) packet `p`'s frustum reached, in order.
+    pub fn leaves(&self, p: usize) -> &[u32] {
+        let [start, len] = self.lists.ranges[p];
+        &self.lists.pairs.node[start as usize..(start + len) as usize]
+    }
+}
+
+/// The scene a stream trace runs over: the level-order tree, the scene box and its largest
+/// coordinate magnitude (the slack of the depth-first methods is made from it).
+#[derive(Clone, Copy, Debug)]
+pub struct StreamScene<'a> {
+    /// The tree.
+    pub tree: &'a LevelBvh,
+    /// The scene box.
+    pub bounds: Aabb,
+    /// Its largest coordinate magnitude.
+    pub scene_scale: f32,
+}
+
+/// Stages one to three: keys, the sort, packets, frustums, the breadth-first traversal.
+pub fn plan<P: Parallel, F: FrustumTest>(
+    exec: &P,
+    scene: &StreamScene<'_>,
+    rays: &[Ray],
+    params: &StreamParams,
+    seconds: &mut StageSeconds,
+) -> Result<StreamPlan, Error> {
+    params.check()?;
+    let t0 = seconds_since(None);
+    let grid = RayGrid::new(&scene.bounds, params);
+    let keys = exec.map(rays.len(), |i| grid.key(&rays[i]));
+    let order = sort_by_key(&keys);
+    let sorted: Vec<u32> = order.iter().map(|&i| keys[i as usize]).collect();
+    let bounds = packets(&sorted, params.max_packet);
+    seconds.sort = seconds_since(Some(t0));
+    let t1 = seconds_since(None);
+    let frustums = exec.map(bounds.len().saturating_sub(1), |p| {
+        let ids = &order[bounds[p] as usize..bounds[p + 1] as usize];
+        Frustum::build(ids.iter().map(|&i| &rays[i as usize]), &scene.bounds, scene.scene_scale)
+    });
+    seconds.frustums = seconds_since(Some(t1));
+    let t2 = seconds_since(None);
+    let lists = traverse::<P, F>(exec, scene.tree.nodes(), &frustums);
+    seconds.traversal = seconds_since(Some(t2));
+    Ok(StreamPlan { keys, order, packets: bounds, frustums, lists })
+}
+
+/// What [`trace_stream`] returns besides the hits.
+#[derive(Clone, Debug, Default)]
+pub struct StreamOutput {
+    /// Working figures and stage times.
+    pub stats: StreamStats,
+    /// Work counters of the intersection stage (when asked for).
+    pub counters: Option<Counters>,
+    /// Per ray: its packet, then the canonical ids of the packet's leaves in order (when asked
+    /// for). This is the method's enumeration: it pins down the sort, the packets and the
+    /// traversal, and the hits pin down the intersection.
+    pub enumerations: Option<Vec<Vec<u32>>>,
+}
+
+/// Traces `rays` into `hits` (same length) with the stream method; `count` and `enumerate` say
+/// what to record.
+#[allow(clippy::too_many_arguments)]
+pub fn trace_stream<P: Parallel, F: FrustumTest, T: TriangleTest, K: ChildKernel>(
+    exec: &P,
+    scene: &StreamScene<'_>,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    params: &StreamParams,
+    count: bool,
+    enumerate: bool,
+) -> Result<StreamOutput, Error> {
+    crate::trace::check_buffers(rays, hits)?;
+    let mut seconds = StageSeconds::default();
+    let plan = plan::<P, F>(exec, scene, rays, params, &mut seconds)?;
+    let t3 = seconds_since(None);
+    let counters = if count {
+        Some(intersect_all::<P, T, K, Counters>(exec, scene, &plan, rays, query, hits))
+    } else {
+        intersect_all::<P, T, K, NoObserver>(exec, scene, &plan, rays, query, hits);
+        None
+    };
+    seconds.intersection = seconds_since(Some(t3));
+    let enumerations = enumerate.then(|| {
+        let mut out = vec![Vec::new(); rays.len()];
+        for p in 0..plan.packet_count() {
+            let mut list = vec![p as u32];
+            list.extend(plan.leaves(p).iter().map(|&l| scene.tree.canonical_id(l)));
+            for &i in plan.packet(p) {
+                out[i as usize] = list.clone();
+            }
+        }
+        out
+    });
+    let lists = &plan.lists;
+    let biggest_queue = lists.queue_sizes.iter().copied().max().unwrap_or(0) as usize;
+    let stats = StreamStats {
+        packets: plan.packet_count(),
+        active_frustums: plan.frustums.iter().filter(|f| f.active > 0).count(),
+        queue_sizes: lists.queue_sizes.clone(),
+        leaf_refs: lists.pairs.node.len(),
+        box_tests: lists.box_tests,
+        working_bytes: 4 * (2 * rays.len() + plan.packets.len())
+            + plan.frustums.len() * core::mem::size_of::<Frustum>()
+            + 2 * 8 * biggest_queue,
+        seconds,
+    };
+    Ok(StreamOutput { stats, counters, enumerations })
+}
+
+/// Stage four over every packet, the hits put back in ray order; the observers' sum.
+fn intersect_all<P: Parallel, T: TriangleTest, K: ChildKernel, O: Observer + Default + Send + Summed>(
+    exec: &P,
+    scene: &StreamScene<'_>,
+    plan: &StreamPlan,
+    rays: &[Ray],
+    query: Query,
+    hits: &mut [Hit],
+) -> O {
+    let per_packet = exec.map(plan.packet_count(), |p| {
+        let ids = plan.packet(p);
+        let mut out = vec![Hit::MISS; ids.len()];
+        let mut obs = O::default();
+        intersect_packet::<T, K, O>(scene.tree, plan.leaves(p), rays, ids, scene.scene_scale, query, &mut out, &mut obs);
+        (out, obs)
+    });
+    let mut total = O::default();
+    for (p, (packet_hits, obs)) in per_packet.into_iter().enumerate() {
+        for (&i, h) in plan.packet(p).iter().zip(packet_hits) {
+            hits[i as usize] = h;
+        }
+        total.add_from(&obs);
+    }
+    total
+}
+
+/// Observers whose per-packet values add up.
+pub trait Summed {
+    /// Adds `other` to `self`.
+    fn add_from(&mut self, other: &Self);
+}
+
+impl Summed for Counters {
+    fn add_from(&mut self, other: &Self) {
+        self.add(other);
+    }
+}
+
+impl Summed for NoObserver {
+    fn add_from(&mut self, _: &Self) {}
+}

@@ -1,0 +1,153 @@
+//! Ray hashing (Garanzha & Loop 2010, Sec. 3.1): a ray's origin and direction quantized on two
+//! virtual grids and merged into a 32-bit key; rays with equal keys are taken to be coherent.
+
+use super::StreamParams;
+use crate::{Aabb, Ray};
+use glam::Vec3;
+
+/// Cells per axis are capped at 2^10 so a cell index fits the Morton code's 10 bits.
+const MAX_CELLS: u32 = 1 << 10;
+
+/// The key of a ray no method can trace ([`Ray::is_traceable`]): sorted last, never in a frustum.
+pub const UNTRACEABLE_KEY: u32 = u32::MAX;
+
+/// The two virtual grids: origins over the scene box, directions over the faces of the unit cube.
+///
+/// The paper leaves open how the two cell ids are merged into 32 bits. Here the exact cell pair
+/// is the key when the grids have at most 2^32 cell pairs; otherwise the pair is hashed to 32 bits
+/// by a fixed mixing function. A collision merely puts two cells' rays into one packet, whose
+/// frustum then bounds both: slower, never wrong.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayGrid {
+    lo: Vec3,
+    inv_cell: f32,
+    cells: [u32; 3],
+    origin_bits: u32,
+    dir_cells: u32,
+    face_bits: u32,
+    exact: bool,
+}
+
+impl RayGrid {
+    /// The grids for a scene with bounds `scene` and the cell sizes of `params`.
+    pub fn new(scene: &Aabb, params: &StreamParams) -> RayGrid {
+        let extent = scene.extent().max(Vec3::ZERO);
+        let diagonal = extent.length();
+        let cell = params.origin_cell_fraction * diagonal;
+        let inv_cell = if cell > 0.0 && cell.is_finite() { 1.0 / cell } else { 0.0 };
+        let per_axis = |e: f32| ((e * inv_cell).ceil() as u32).clamp(1, MAX_CELLS);
+        let cells = [per_axis(extent.x), per_axis(extent.y), per_axis(extent.z)];
+        let widest = cells.iter().copied().max().unwrap_or(1);
+        let origin_bits = 3 * (u32::BITS - (widest - 1).leading_zeros());
+        let dir_cells = ((1.0 / params.direction_cell_fraction).ceil() as u32).clamp(1, MAX_CELLS);
+        let face_bits = 2 * (u32::BITS - (dir_cells - 1).leading_zeros());
+        // Six faces need three bits above the position on the face.
+        let exact = 3 + face_bits + origin_bits <= 32;
+        let lo = if scene.is_empty() { Vec3::ZERO } else { scene.min };
+        RayGrid { lo, inv_cell, cells, origin_bits, dir_cells, face_bits, exact }
+    }
+
+    /// The ray's 32-bit key ([`UNTRACEABLE_KEY`] for a ray that cannot be traced).
+    pub fn key(&self, ray: &Ray) -> u32 {
+        if !ray.is_traceable() {
+            return UNTRACEABLE_KEY;
+        }
+        let rel = (ray.origin() - self.lo) * self.inv_cell;
+        // `as u32` saturates (and maps NaN to 0), so origins outside the box land in its border cells.
+        let cell = |x: f32, n: u32| (x as u32).min(n - 1);
+        let origin = morton3(cell(rel.x, self.cells[0]), cell(rel.y, self.cells[1]), cell(rel.z, self.cells[2]));
+        let id = (u64::from(self.direction_cell(ray.dir())) << self.origin_bits) | u64::from(origin);
+        let key = if self.exact { id as u32 } else { mix(id) };
+        // The untraceable key is reserved.
+        key.min(UNTRACEABLE_KEY - 1)
+    }
+
+    /// The direction's cell: the cube face it points through (dominant axis and sign), then its
+    /// position on that face, Morton-ordered.
+    fn direction_cell(&self, d: Vec3) -> u32 {
+        let a = d.abs();
+        let axis = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let face = 2 * axis + u32::from(d[axis as usize].is_sign_negative());
+        let (u, v) = (d[(axis as usize + 1) % 3] / a[axis as usize], d[(axis as usize + 2) % 3] / a[axis as usize]);
+        let n = self.dir_cells;
+        let cell = |x: f32| (((x + 1.0) * 0.5 * n as f32) as u32).min(n - 1);
+        (face << self.face_bits) | morton2(cell(u), cell(v))
+    }
+}
+
+/// Interleaves the low 10 bits of three values.
+fn morton3(x: u32, y: u32, z: u32) -> u32 {
+    fn spread(v: u32) -> u32 {
+        let mut v = v & 0x3ff;
+        v = (v | (v << 16)) & 0x0300_00ff;
+        v = (v | (v << 8)) & 0x0300_f00f;
+        v = (v | (v << 4)) & 0x030c_30c3;
+        (v | (v << 2)) & 0x0924_9249
+    }
+    spread(x) | (spread(y) << 1) | (spread(z) << 2)
+}
+
+/// Interleaves the low 10 bits of two values.
+fn morton2(x: u32, y: u32) -> u32 {
+    fn spread(v: u32) -> u32 {
+        let mut v = v & 0x3ff;
+        v = (v | (v << 8)) & 0x00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333;
+        (v | (v << 1)) & 0x5555_5555
+    }
+    spread(x) | (spread(y) << 1)
+}
+
+/// A fixed 64-to-32-bit mixing function (the finalizer of splitmix64).
+fn mix(id: u64) -> u32 {
+    let mut z = id.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    (z ^ (z >> 31)) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid() -> RayGrid {
+        RayGrid::new(&Aabb::new(Vec3::ZERO, Vec3::splat(1.0)), &StreamParams::default())
+    }
+
+    #[test]
+    fn nearby_rays_share_a_key_and_far_ones_do_not() {
+        let g = grid();
+        let r = |o: Vec3, d: Vec3| Ray::new(o, d, 0.0, f32::INFINITY);
+        let a = g.key(&r(Vec3::splat(0.5), Vec3::new(1.0, 0.1, 0.2)));
+        assert_eq!(a, g.key(&r(Vec3::splat(0.5001), Vec3::new(1.0, 0.1001, 0.2))));
+        assert_ne!(a, g.key(&r(Vec3::splat(0.9), Vec3::new(1.0, 0.1, 0.2))), "another origin cell");
+        assert_ne!(a, g.key(&r(Vec3::splat(0.5), Vec3::new(-1.0, 0.1, 0.2))), "another cube face");
+        assert_ne!(a, g.key(&r(Vec3::splat(0.5), Vec3::new(1.0, 0.5, 0.2))), "another cell on the face");
+    }
+
+    #[test]
+    fn untraceable_rays_and_outside_origins() {
+        let g = grid();
+        assert_eq!(g.key(&Ray::new(Vec3::NAN, Vec3::X, 0.0, 1.0)), UNTRACEABLE_KEY);
+        assert_eq!(g.key(&Ray::new(Vec3::ZERO, Vec3::ZERO, 0.0, 1.0)), UNTRACEABLE_KEY);
+        // Far outside the box: clamped into a border cell, not wrapped around.
+        let far = g.key(&Ray::new(Vec3::splat(-1e30), Vec3::X, 0.0, 1.0));
+        assert_eq!(far, g.key(&Ray::new(Vec3::ZERO, Vec3::X, 0.0, 1.0)));
+    }
+
+    #[test]
+    fn morton_codes_interleave() {
+        assert_eq!(morton3(1, 0, 0), 1);
+        assert_eq!(morton3(0, 1, 0), 2);
+        assert_eq!(morton3(0, 0, 1), 4);
+        assert_eq!(morton3(0x3ff, 0x3ff, 0x3ff), (1 << 30) - 1);
+        assert_eq!(morton2(3, 0), 0b0101);
+    }
+}
