@@ -6,7 +6,7 @@ use crate::intersect::SlabRay;
 use crate::traverse::begin_slab;
 use crate::{Aabb, Ray};
 use bytemuck::{Pod, Zeroable};
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
 /// [`Frustum::axis`] of a packet whose rays share no dominant axis: only the segments' box culls.
 pub const NO_AXIS: u32 = 3;
@@ -15,7 +15,7 @@ pub const NO_AXIS: u32 = 3;
 /// coordinate magnitude plus the largest origin coordinate): 2^-14, some sixty times what the
 /// slab test's rounding and the `f32` evaluation of the planes can move a bound by (each about
 /// 2^-20 of the reach), so a box the slab test lets any ray of the packet enter is never culled.
-pub const MARGIN: f64 = 1.0 / 16384.0;
+pub const MARGIN: f32 = 1.0 / 16384.0;
 
 /// A packet's frustum, laid out for the GPU as well (`repr(C)`, 80 bytes, twenty 4-byte words).
 ///
@@ -112,92 +112,93 @@ impl Frustum {
     /// The frustum of `rays` in a scene with bounds `scene` and largest coordinate magnitude
     /// `scene_scale`. A ray that cannot be traced, or whose slab test misses the scene box over
     /// its widened interval, is left out: no method finds a hit for it.
+    ///
+    /// All in `f32`, one IEEE operation at a time in a fixed order (products rounded before they
+    /// are added, correctly rounded divisions), so a GPU kernel that does the same gets the same
+    /// bits. Each bound is then off by a few units of `2^-23` times the reach at most, far inside
+    /// [`MARGIN`].
     pub fn build<'a>(rays: impl Iterator<Item = &'a Ray> + Clone, scene: &Aabb, scene_scale: f32) -> Frustum {
-        // Each active ray's segment inside the scene box, in f64.
-        let segment = |ray: &Ray| -> Option<(DVec3, DVec3, DVec3, f64)> {
-            let slab: SlabRay = begin_slab(ray, scene_scale)?;
-            let (t0, t1) = slab.widen(ray.tmin, ray.tmax);
-            let h = slab.hit(scene.min, scene.max, t0, t1)?;
-            let (o, d) = (ray.origin().as_dvec3(), ray.dir().as_dvec3());
-            let reach = f64::from(scene_scale) + o.abs().max_element();
-            Some((o + d * f64::from(h.t_enter), o + d * f64::from(h.t_exit), d, reach))
-        };
         let mut active = 0u32;
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        let (mut mean, mut reach) = (DVec3::ZERO, 0.0f64);
-        // Per axis: the smallest |d_a| / max|d| over the rays, and whether every d_a had one sign.
-        let mut min_share = [f64::INFINITY; 3];
-        let mut signs = [(false, false); 3];
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let (mut mean, mut reach) = (Vec3::ZERO, 0.0f32);
+        // Per axis: the smallest |d_a| / max|d| over the rays, and which signs d_a took.
+        let mut min_share = [f32::INFINITY; 3];
+        let (mut positive, mut negative) = ([false; 3], [false; 3]);
         for ray in rays.clone() {
-            let Some((p0, p1, d, r)) = segment(ray) else { continue };
+            let Some(s) = Segment::of(ray, scene, scene_scale) else { continue };
             active += 1;
-            lo = lo.min(p0.min(p1));
-            hi = hi.max(p0.max(p1));
-            let dmax = d.abs().max_element();
-            mean += d / dmax;
-            reach = reach.max(r);
+            lo = lo.min(s.p0.min(s.p1));
+            hi = hi.max(s.p0.max(s.p1));
+            let dmax = s.d.abs().max_element();
+            mean += s.d / dmax;
+            reach = reach.max(s.reach);
             for a in 0..3 {
-                min_share[a] = min_share[a].min(d[a].abs() / dmax);
-                if d[a] > 0.0 {
-                    signs[a].0 = true;
-                } else if d[a] < 0.0 {
-                    signs[a].1 = true;
-                } else {
-                    (signs[a].0, signs[a].1) = (true, true);
-                }
+                min_share[a] = min_share[a].min(s.d[a].abs() / dmax);
+                // A zero component counts as both signs: no frustum along that axis.
+                positive[a] |= s.d[a] >= 0.0;
+                negative[a] |= s.d[a] <= 0.0;
             }
         }
         if active == 0 {
             return Frustum::EMPTY;
         }
+        // A power of two: the product is exact.
         let m = reach * MARGIN;
         let (lo, hi) = (lo - m, hi + m);
-        let dir_signs = (0..3).map(|a| u32::from(mean[a] < 0.0) << a).sum();
-        // Rounding to f32 moves a bound by far less than the margin.
-        let mut f = Frustum {
-            lo: lo.as_vec3().to_array(),
-            axis: NO_AXIS,
-            hi: hi.as_vec3().to_array(),
-            active,
-            dir_signs,
-            ..Frustum::EMPTY
-        };
+        let dir_signs = u32::from(mean.x < 0.0) | u32::from(mean.y < 0.0) << 1 | u32::from(mean.z < 0.0) << 2;
+        let mut f = Frustum { lo: lo.to_array(), axis: NO_AXIS, hi: hi.to_array(), active, dir_signs, ..Frustum::EMPTY };
         if !(lo.is_finite() && hi.is_finite()) {
-            // Segments beyond the f32 range: the box alone, unbounded.
+            // Segments beyond the f32 range: nothing is culled.
             (f.lo, f.hi) = ([f32::NEG_INFINITY; 3], [f32::INFINITY; 3]);
             return f;
         }
-        // The dominant axis: one sign for every ray, and the largest smallest share. Below a
-        // share of 1/4 the side planes would slope by more than 4 and the f32 evaluation of them
-        // could stray past the margin: such a packet keeps the box alone.
-        let Some(a) = (0..3).filter(|&a| signs[a].0 != signs[a].1).max_by(|&x, &y| min_share[x].total_cmp(&min_share[y]))
-        else {
-            return f;
-        };
-        if min_share[a] < 0.25 {
-            return f;
+        // The dominant axis: one sign for every ray, and the largest smallest share (a later axis
+        // wins a tie). Below a share of 1/4 the side planes would slope by more than 4 and their
+        // f32 evaluation could stray toward the margin: such a packet keeps the box alone.
+        let mut axis = None;
+        for a in 0..3 {
+            if positive[a] != negative[a] && axis.is_none_or(|b: usize| min_share[a] >= min_share[b]) {
+                axis = Some(a);
+            }
         }
+        let Some(a) = axis.filter(|&a| min_share[a] >= 0.25) else { return f };
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
         let (near, far) = (lo[a], hi[a]);
-        let (mut n, mut fr) = ([f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY], [0.0; 4]);
-        fr.copy_from_slice(&n);
+        let mut n = [f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY];
+        let mut fr = n;
         for ray in rays {
-            let Some((p0, _, d, _)) = segment(ray) else { continue };
+            let Some(s) = Segment::of(ray, scene, scene_scale) else { continue };
             for (x, rect) in [(near, &mut n), (far, &mut fr)] {
-                let s = (x - p0[a]) / d[a];
-                let (u, v) = (p0[b] + s * d[b], p0[c] + s * d[c]);
+                let k = (x - s.p0[a]) / s.d[a];
+                let (u, v) = (s.p0[b] + k * s.d[b], s.p0[c] + k * s.d[c]);
                 *rect = [rect[0].min(u), rect[1].max(u), rect[2].min(v), rect[3].max(v)];
             }
         }
-        let widen = |r: [f64; 4]| [r[0] - m, r[1] + m, r[2] - m, r[3] + m];
-        let (n, fr) = (widen(n), widen(fr));
         f.axis = a as u32;
-        f.near = near as f32;
-        f.far = far as f32;
-        f.inv_span = if f.far > f.near { 1.0 / (f.far - f.near) } else { 0.0 };
-        f.near_rect = [n[0] as f32, n[1] as f32, n[2] as f32, n[3] as f32];
-        f.far_rect = [fr[0] as f32, fr[1] as f32, fr[2] as f32, fr[3] as f32];
+        (f.near, f.far) = (near, far);
+        f.inv_span = if far > near { 1.0 / (far - near) } else { 0.0 };
+        f.near_rect = [n[0] - m, n[1] + m, n[2] - m, n[3] + m];
+        f.far_rect = [fr[0] - m, fr[1] + m, fr[2] - m, fr[3] + m];
         f
+    }
+}
+
+/// An active ray's segment inside the scene box over its widened interval.
+struct Segment {
+    p0: Vec3,
+    p1: Vec3,
+    d: Vec3,
+    /// The scene scale plus the origin's largest coordinate magnitude.
+    reach: f32,
+}
+
+impl Segment {
+    fn of(ray: &Ray, scene: &Aabb, scene_scale: f32) -> Option<Segment> {
+        let slab: SlabRay = begin_slab(ray, scene_scale)?;
+        let (t0, t1) = slab.widen(ray.tmin, ray.tmax);
+        let h = slab.hit(scene.min, scene.max, t0, t1)?;
+        let (o, d) = (ray.origin(), ray.dir());
+        Some(Segment { p0: o + d * h.t_enter, p1: o + d * h.t_exit, d, reach: scene_scale + o.abs().max_element() })
     }
 }
 
