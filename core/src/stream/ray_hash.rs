@@ -19,13 +19,20 @@ pub const UNTRACEABLE_KEY: u32 = u32::MAX;
 /// frustum then bounds both: slower, never wrong.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayGrid {
-    lo: Vec3,
-    inv_cell: f32,
-    cells: [u32; 3],
-    origin_bits: u32,
-    dir_cells: u32,
-    face_bits: u32,
-    exact: bool,
+    /// Lower corner of the origin grid (the scene box's).
+    pub lo: Vec3,
+    /// `1 / cell size` of the origin grid (0 for a scene of no extent: one cell).
+    pub inv_cell: f32,
+    /// Origin cells per axis (1 to 1024).
+    pub cells: [u32; 3],
+    /// Bits of the origin cell's Morton code (3 per bit of the widest axis's cell index).
+    pub origin_bits: u32,
+    /// Direction cells per side of a cube face (1 to 1024).
+    pub dir_cells: u32,
+    /// Bits of a position on a face (2 per bit of `dir_cells - 1`).
+    pub face_bits: u32,
+    /// Whether the cell pair fits 32 bits as it is (else it is mixed down to 32).
+    pub exact: bool,
 }
 
 impl RayGrid {
