@@ -112,6 +112,23 @@ struct RowView<'a> {
     nodes_per_ray: Option<f64>,
     leaves_per_ray: Option<f64>,
     tests_per_ray: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stream: Option<StreamView<'a>>,
+}
+
+/// A stream target's stage seconds and working figures.
+#[derive(Serialize)]
+struct StreamView<'a> {
+    packets: usize,
+    active_frustums: usize,
+    queue_sizes: &'a [u32],
+    leaf_refs: usize,
+    box_tests: u64,
+    working_bytes: usize,
+    sort_s: f64,
+    frustums_s: f64,
+    traversal_s: f64,
+    intersection_s: f64,
 }
 
 impl<'a> From<&'a Row> for RowView<'a> {
@@ -128,6 +145,18 @@ impl<'a> From<&'a Row> for RowView<'a> {
             nodes_per_ray: w.nodes,
             leaves_per_ray: w.leaves,
             tests_per_ray: w.tests,
+            stream: r.stream.as_ref().map(|st| StreamView {
+                packets: st.packets,
+                active_frustums: st.active_frustums,
+                queue_sizes: &st.queue_sizes,
+                leaf_refs: st.leaf_refs,
+                box_tests: st.box_tests,
+                working_bytes: st.working_bytes,
+                sort_s: st.seconds.sort,
+                frustums_s: st.seconds.frustums,
+                traversal_s: st.seconds.traversal,
+                intersection_s: st.seconds.intersection,
+            }),
         }
     }
 }
@@ -177,6 +206,7 @@ mod tests {
             mrays_per_s: 3.0,
             ratio,
             work,
+            stream: None,
         };
         let agreement = Agreement {
             rays: 10,

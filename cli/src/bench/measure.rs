@@ -95,14 +95,17 @@ impl Plan<'_> {
                     mrays_per_s,
                     ratio: None,
                     work: None,
+                    stream: None,
                 });
             }
         }
         if let Some((_, pool)) = self.pools.last() {
             for t in self.targets {
                 let work = t.work(pool, rays, query)?;
+                let stream = t.stream_stats(pool, rays, query)?;
                 for r in rows.iter_mut().filter(|r| r.target == t.name()) {
                     r.work = work;
+                    r.stream.clone_from(&stream);
                 }
                 progress.step(&format!("{kind} {} work", t.name()));
             }

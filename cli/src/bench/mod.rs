@@ -141,8 +141,16 @@ fn bench_scene(
     let cpu = CpuScene(prepared);
 
     let stack = RaytrailCpu::new(Method::Bvh2(Bvh2Method::Stack), cpu.clone());
-    let mut targets: Targets =
-        opts.methods.iter().map(|&m| Box::new(RaytrailCpu::new(m, cpu.clone())) as Box<dyn BenchTarget>).collect();
+    let mut targets: Targets = Vec::new();
+    for &m in &opts.methods {
+        if m.stream().is_some() {
+            for &params in &opts.stream {
+                targets.push(Box::new(RaytrailCpu::stream(m, params, cpu.clone())));
+            }
+        } else {
+            targets.push(Box::new(RaytrailCpu::new(m, cpu.clone())));
+        }
+    }
     targets.extend(gpu_targets(opts, &cpu)?);
     let (built, _) = timed("building the peers' trees", || peers::build(&opts.peers, scene, largest));
     let (peer_targets, peer_builds) = built?;

@@ -5,6 +5,7 @@ use super::view::ViewChoice;
 use crate::args::{LoadFlags, BUILDERS};
 use clap::Parser;
 use raytrail::core::method::Method;
+use raytrail::core::stream::StreamParams;
 use raytrail::{Builder, BUILTIN_SCENE};
 
 /// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
@@ -62,6 +63,8 @@ pub struct Options {
     pub view: ViewChoice,
     /// Fail on mesh elements that are not triangles or polygons instead of skipping them.
     pub strict: bool,
+    /// Parameter sets of the stream method: one target per set (the first is the default's).
+    pub stream: Vec<StreamParams>,
 }
 
 /// The `raytrail bench` flags as given; [`Options::from_args`] checks them.
@@ -71,7 +74,7 @@ pub struct BenchArgs {
     /// Scene files (or `builtin`), comma-separated
     #[arg(long, short = 's', value_name = "FILE[,FILE...]", default_value = BUILTIN_SCENE)]
     pub scene: String,
-    /// Ray types, comma-separated: primary, shadow, diffuse, ao [default: all]
+    /// Ray types, comma-separated: primary, shadow, soft-shadow, diffuse, ao [default: all]
     #[arg(long, value_name = "TYPE[,TYPE...]")]
     pub rays: Option<String>,
     /// Primary image width
@@ -111,6 +114,14 @@ pub struct BenchArgs {
     /// Leave the GPU out even when wgpu finds an adapter
     #[arg(long)]
     pub no_gpu: bool,
+    /// Stream method: most rays per packet (Garanzha & Loop's MaxSize), comma-separated for a
+    /// parameter study [default: 256]
+    #[arg(long, value_name = "N[,N...]")]
+    pub stream_packet: Option<String>,
+    /// Stream method: origin cell size as a fraction of the scene's diagonal (UserCellFraction),
+    /// comma-separated for a parameter study [default: 0.004]
+    #[arg(long, value_name = "F[,F...]")]
+    pub stream_cell: Option<String>,
     /// Camera views: outside, inside, both, or auto (inside too where it sees a room)
     #[arg(long, default_value = ViewChoice::DEFAULT.name(), value_parser = ViewChoice::ALL.map(ViewChoice::name))]
     pub view: String,
@@ -224,7 +235,9 @@ impl Options {
             (None, Some(first)) if peers.is_empty() => first.name().to_string(),
             (None, _) => "obvhs-bvh2".to_string(),
         };
+        let stream = stream_params(a.stream_packet.as_deref(), a.stream_cell.as_deref())?;
         Ok(Options {
+            stream,
             scenes,
             rays,
             width,
@@ -243,6 +256,42 @@ impl Options {
             strict: a.load.strict,
         })
     }
+}
+
+/// Every combination of the given packet sizes and cell fractions (defaults where not given).
+fn stream_params(packets: Option<&str>, cells: Option<&str>) -> Result<Vec<StreamParams>, String> {
+    let base = StreamParams::default();
+    let packets: Vec<u32> = match packets {
+        None => vec![base.max_packet],
+        Some(v) => list(v)
+            .iter()
+            .map(|n| match n.parse::<u32>() {
+                Ok(k) if (1..=1 << 20).contains(&k) => Ok(k),
+                _ => Err(format!("--stream-packet: '{n}' is not a packet size between 1 and 2^20")),
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    let cells: Vec<f32> = match cells {
+        None => vec![base.origin_cell_fraction],
+        Some(v) => list(v)
+            .iter()
+            .map(|n| match n.parse::<f32>() {
+                Ok(f) if f.is_finite() && f > 0.0 && f <= 1.0 => Ok(f),
+                _ => Err(format!("--stream-cell: '{n}' is not a fraction in (0, 1]")),
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    if packets.is_empty() || cells.is_empty() {
+        return Err("--stream-packet/--stream-cell: no value given".to_string());
+    }
+    Ok(unique(
+        packets
+            .iter()
+            .flat_map(|&max_packet| {
+                cells.iter().map(move |&origin_cell_fraction| StreamParams { max_packet, origin_cell_fraction, ..base })
+            })
+            .collect(),
+    ))
 }
 
 /// The non-empty items of a comma-separated list, trimmed.

@@ -287,6 +287,7 @@ mod tests {
             mrays_per_s,
             ratio: None,
             work: None,
+            stream: None,
         };
         let rays = RayReport {
             kind: RayKind::Primary,

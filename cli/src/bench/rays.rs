@@ -1,7 +1,8 @@
-//! The bench's ray types, made once per scene: primary, shadow, diffuse and ambient occlusion.
+//! The bench's ray types, made once per scene: primary, shadow, soft shadow, diffuse and ambient
+//! occlusion.
 //!
-//! Primary, shadow and diffuse rays come from the conformance suite's generators; the
-//! ambient-occlusion generator lives here. Primary rays come from one camera [`View`] of the
+//! Primary, shadow and diffuse rays come from the conformance suite's generators; the soft-shadow
+//! and ambient-occlusion generators live here. Primary rays come from one camera [`View`] of the
 //! scene; the other kinds follow from their hits, so each view gets its own four sets.
 
 use super::view::View;
@@ -18,6 +19,16 @@ pub const AO_RADIUS: f32 = 0.05;
 /// Seed stream of the ambient-occlusion rays (distinct from the diffuse rays' [`RAY_SEED`]).
 const AO_SEED: u64 = RAY_SEED ^ 0xA0;
 
+/// Seed stream of the soft-shadow rays.
+const SOFT_SHADOW_SEED: u64 = RAY_SEED ^ 0x50F7;
+
+/// Soft-shadow rays per primary hit: a 2 x 2 stratification of the area light (Garanzha & Loop
+/// use up to 16 per shading point; 4 keeps the batch the size of the others).
+pub const SOFT_SHADOW_SAMPLES: usize = 4;
+
+/// Side of the square area light, as a fraction of the scene's diagonal.
+pub const AREA_LIGHT_SIDE: f32 = 0.25;
+
 /// A kind of ray the bench traces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum RayKind {
@@ -25,6 +36,9 @@ pub enum RayKind {
     Primary,
     /// From primary hits to a point light, any hit.
     Shadow,
+    /// From primary hits to stratified points of a square area light, any hit: the coherent
+    /// secondary rays of Garanzha & Loop's measurements.
+    SoftShadow,
     /// Cosine-weighted bounces from primary hits, closest hit.
     Diffuse,
     /// Short cosine-weighted rays from primary hits, any hit.
@@ -33,13 +47,15 @@ pub enum RayKind {
 
 impl RayKind {
     /// Every kind, in the order they are made and reported.
-    pub const ALL: [RayKind; 4] = [RayKind::Primary, RayKind::Shadow, RayKind::Diffuse, RayKind::Ao];
+    pub const ALL: [RayKind; 5] =
+        [RayKind::Primary, RayKind::Shadow, RayKind::SoftShadow, RayKind::Diffuse, RayKind::Ao];
 
     /// Command-line and report name.
     pub fn name(self) -> &'static str {
         match self {
             RayKind::Primary => "primary",
             RayKind::Shadow => "shadow",
+            RayKind::SoftShadow => "soft-shadow",
             RayKind::Diffuse => "diffuse",
             RayKind::Ao => "ao",
         }
@@ -54,7 +70,7 @@ impl RayKind {
     pub fn query(self) -> Query {
         match self {
             RayKind::Primary | RayKind::Diffuse => Query::Closest,
-            RayKind::Shadow | RayKind::Ao => Query::Any,
+            RayKind::Shadow | RayKind::SoftShadow | RayKind::Ao => Query::Any,
         }
     }
 }
@@ -84,6 +100,7 @@ pub fn batches(
             let rays = match kind {
                 RayKind::Primary => primary_rays.to_vec(),
                 RayKind::Shadow => shadow(primary_rays, primary_hits, default_light(bounds), scene_epsilon(bounds)),
+                RayKind::SoftShadow => soft_shadow(primary_rays, primary_hits, scene, SOFT_SHADOW_SEED),
                 RayKind::Diffuse => diffuse(primary_rays, primary_hits, scene, RAY_SEED),
                 RayKind::Ao => ambient_occlusion(primary_rays, primary_hits, scene, ao_per_hit, AO_SEED),
             };
@@ -110,6 +127,37 @@ pub fn ambient_occlusion(rays: &[Ray], hits: &[Hit], scene: &Scene, per_hit: usi
     let mut out = Vec::with_capacity(hits.iter().filter(|h| h.is_hit()).count() * per_hit);
     for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
         shape.push_rays(scene, ray, hit, &mut Pcg32::new(seed, i as u64), &mut out);
+    }
+    out
+}
+
+/// [`SOFT_SHADOW_SAMPLES`] rays per hit of `rays` toward a square area light, grouped by primary
+/// ray in the order of `rays`.
+///
+/// The light is centred on the point light of the shadow rays ([`default_light`]), faces the
+/// scene's centre, and has a side of [`AREA_LIGHT_SIDE`] of the diagonal. Sample `k` of a hit falls
+/// in stratum `k` of a 2 x 2 grid over the light, jittered; the ray runs from the hit point to the
+/// sample over `[eps / len, 1 - eps / len]` as the point-light shadow rays do. Each primary ray's
+/// random stream is keyed by its index.
+pub fn soft_shadow(rays: &[Ray], hits: &[Hit], scene: &Scene, seed: u64) -> Vec<Ray> {
+    let bounds = scene.bounds();
+    let (center, eps) = (default_light(bounds), scene_epsilon(bounds));
+    let side = AREA_LIGHT_SIDE * bounds.extent().length().max(f32::MIN_POSITIVE);
+    let (u, v) = (center - bounds.center()).normalize_or(Vec3::Y).any_orthonormal_pair();
+    let strata = (SOFT_SHADOW_SAMPLES as f32).sqrt().ceil() as usize;
+    let mut out = Vec::with_capacity(hits.iter().filter(|h| h.is_hit()).count() * SOFT_SHADOW_SAMPLES);
+    for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+        let Some(p) = hit_point(ray, hit) else { continue };
+        let mut rng = Pcg32::new(seed, i as u64);
+        for k in 0..SOFT_SHADOW_SAMPLES {
+            let sx = ((k % strata) as f32 + rng.next_f32()) / strata as f32 - 0.5;
+            let sy = ((k / strata) as f32 + rng.next_f32()) / strata as f32 - 0.5;
+            let dir = center + (u * sx + v * sy) * side - p;
+            let len = dir.length();
+            if len.is_finite() && len > 2.0 * eps {
+                out.push(Ray::new(p, dir, eps / len, 1.0 - eps / len));
+            }
+        }
     }
     out
 }

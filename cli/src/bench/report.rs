@@ -5,6 +5,7 @@ use super::agreement::Agreement;
 use super::rays::RayKind;
 use super::target::{TargetKind, Work};
 use super::view::View;
+use raytrail::core::stream::StreamStats;
 
 /// One build step: what was built, how long it took, and the memory it holds.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,6 +37,8 @@ pub struct Row {
     pub ratio: Option<f64>,
     /// Work per ray, where counted.
     pub work: Option<Work>,
+    /// A stream method's stages and working figures (from the work pass).
+    pub stream: Option<StreamStats>,
 }
 
 /// Every row for one ray type of one scene.

@@ -1,7 +1,7 @@
 //! The terminal tables: per scene its builds and memory, then per ray type one row per target with
 //! a speed and ratio column per thread count, work per ray and hit agreement.
 
-use super::report::{mb, RayReport, SceneReport};
+use super::report::{mb, RayReport, Row, SceneReport};
 
 /// Prints everything measured on one scene to standard output.
 pub fn print_scene(s: &SceneReport, baseline: &str, passes: usize) {
@@ -83,6 +83,7 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
             );
         }
     }
+    print_stream_stages(r);
     let notes: Vec<String> = r
         .agreement
         .iter()
@@ -94,6 +95,45 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
         .collect();
     if !notes.is_empty() {
         println!("  disagreements with stack: {}", notes.join("; "));
+    }
+}
+
+/// The stream targets' stages (Garanzha & Loop's Fig. 13) and working figures (their Table 1),
+/// measured in the work pass at the most threads.
+fn print_stream_stages(r: &RayReport) {
+    let rows: Vec<&Row> = {
+        let mut seen: Vec<&str> = Vec::new();
+        r.rows
+            .iter()
+            .filter(|row| row.stream.is_some() && !seen.contains(&row.target.as_str()) && {
+                seen.push(&row.target);
+                true
+            })
+            .collect()
+    };
+    if rows.is_empty() {
+        return;
+    }
+    println!(
+        "  stream stages, ms (one untimed pass):  {:>7} {:>9} {:>9} {:>12}  {:>8} {:>8} {:>9} {:>9}",
+        "sort", "frustums", "traversal", "intersection", "packets", "rays/pk", "leaves/pk", "work MB"
+    );
+    for row in rows {
+        let Some(st) = &row.stream else { continue };
+        let ms = |s: f64| s * 1e3;
+        let per = |x: usize| x as f64 / st.packets.max(1) as f64;
+        println!(
+            "  {:<38} {:>7.1} {:>9.1} {:>9.1} {:>12.1}  {:>8} {:>8.1} {:>9.1} {:>9.1}",
+            row.target,
+            ms(st.seconds.sort),
+            ms(st.seconds.frustums),
+            ms(st.seconds.traversal),
+            ms(st.seconds.intersection),
+            thousands(st.packets as u64),
+            per(r.rays),
+            per(st.leaf_refs),
+            mb(st.working_bytes)
+        );
     }
 }
 

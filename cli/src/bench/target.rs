@@ -3,6 +3,7 @@
 
 use raytrail::core::method::{Method, Query, Structure};
 use raytrail::core::observe::Counters;
+use raytrail::core::stream::{StreamParams, StreamStats};
 use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
@@ -82,6 +83,16 @@ pub trait BenchTarget: Send + Sync {
     }
     /// Counts the work per ray in an extra pass; `None` where the target cannot count.
     fn work(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String>;
+    /// A stream method's stage times and working figures, from one more untimed pass; `None` for
+    /// every other target.
+    fn stream_stats(
+        &self,
+        _pool: &rayon::ThreadPool,
+        _rays: &[Ray],
+        _query: Query,
+    ) -> Result<Option<StreamStats>, String> {
+        Ok(None)
+    }
 }
 
 /// The targets of a run, in report order.
@@ -94,6 +105,8 @@ pub type Targets = Vec<Box<dyn BenchTarget>>;
 /// threads, the same scheduler.
 pub struct RaytrailCpu {
     method: Method,
+    name: String,
+    stream: StreamParams,
     backend: CpuBackend,
     scene: CpuScene,
 }
@@ -101,7 +114,23 @@ pub struct RaytrailCpu {
 impl RaytrailCpu {
     /// The target tracing `method` over `scene`.
     pub fn new(method: Method, scene: CpuScene) -> Self {
-        Self { method, backend: CpuBackend::new(), scene }
+        Self { method, name: method.name().to_string(), stream: StreamParams::default(), backend: CpuBackend::new(), scene }
+    }
+
+    /// The stream method with `params`, named `stream` for the defaults and
+    /// `stream/<packet>/<cell>` otherwise (a parameter study's targets).
+    pub fn stream(method: Method, params: StreamParams, scene: CpuScene) -> Self {
+        let name = if params == StreamParams::default() {
+            method.name().to_string()
+        } else {
+            format!("{}/{}/{}", method.name(), params.max_packet, params.origin_cell_fraction)
+        };
+        Self { method, name, stream: params, backend: CpuBackend::new(), scene }
+    }
+
+    /// The options of a trace with `query` recording `record`.
+    fn options(&self, query: Query, record: Record) -> TraceOptions {
+        TraceOptions::new(self.method).query(query).record(record).stream(self.stream)
     }
 
     /// Traces with `record`, returning the counters when recorded.
@@ -113,17 +142,17 @@ impl RaytrailCpu {
         hits: &mut [Hit],
         record: Record,
     ) -> Result<Option<Counters>, String> {
-        let opts = TraceOptions::new(self.method).query(query).record(record);
+        let opts = self.options(query, record);
         let report = pool
             .install(|| self.backend.trace(&self.scene, rays, &opts, hits))
-            .map_err(|e| format!("{}: {e}", self.method))?;
+            .map_err(|e| format!("{}: {e}", self.name))?;
         Ok(report.counters)
     }
 }
 
 impl BenchTarget for RaytrailCpu {
     fn name(&self) -> &str {
-        self.method.name()
+        &self.name
     }
 
     fn kind(&self) -> TargetKind {
@@ -142,5 +171,17 @@ impl BenchTarget for RaytrailCpu {
         let Some(c) = self.run(pool, rays, query, &mut hits, Record::Counters)? else { return Ok(None) };
         let per_ray = |x: u64| Some(x as f64 / c.rays.max(1) as f64);
         Ok(Some(Work { nodes: per_ray(c.nodes()), leaves: per_ray(c.leaves), tests: per_ray(c.primitive_tests) }))
+    }
+
+    fn stream_stats(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<StreamStats>, String> {
+        if self.method.stream().is_none() {
+            return Ok(None);
+        }
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let opts = self.options(query, Record::Nothing);
+        let report = pool
+            .install(|| self.backend.trace(&self.scene, rays, &opts, &mut hits))
+            .map_err(|e| format!("{}: {e}", self.name))?;
+        Ok(report.stream)
     }
 }

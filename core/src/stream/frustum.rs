@@ -5,6 +5,7 @@
 use crate::intersect::SlabRay;
 use crate::traverse::begin_slab;
 use crate::{Aabb, Ray};
+use alloc::vec::Vec;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
@@ -117,15 +118,15 @@ impl Frustum {
     /// are added, correctly rounded divisions), so a GPU kernel that does the same gets the same
     /// bits. Each bound is then off by a few units of `2^-23` times the reach at most, far inside
     /// [`MARGIN`].
-    pub fn build<'a>(rays: impl Iterator<Item = &'a Ray> + Clone, scene: &Aabb, scene_scale: f32) -> Frustum {
+    pub fn build<'a>(rays: impl Iterator<Item = &'a Ray>, scene: &Aabb, scene_scale: f32) -> Frustum {
         let mut active = 0u32;
         let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         let (mut mean, mut reach) = (Vec3::ZERO, 0.0f32);
         // Per axis: the smallest |d_a| / max|d| over the rays, and which signs d_a took.
         let mut min_share = [f32::INFINITY; 3];
         let (mut positive, mut negative) = ([false; 3], [false; 3]);
-        for ray in rays.clone() {
-            let Some(s) = Segment::of(ray, scene, scene_scale) else { continue };
+        let segments: Vec<Segment> = rays.filter_map(|ray| Segment::of(ray, scene, scene_scale)).collect();
+        for s in &segments {
             active += 1;
             lo = lo.min(s.p0.min(s.p1));
             hi = hi.max(s.p0.max(s.p1));
@@ -166,8 +167,7 @@ impl Frustum {
         let (near, far) = (lo[a], hi[a]);
         let mut n = [f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY];
         let mut fr = n;
-        for ray in rays {
-            let Some(s) = Segment::of(ray, scene, scene_scale) else { continue };
+        for s in &segments {
             for (x, rect) in [(near, &mut n), (far, &mut fr)] {
                 let k = (x - s.p0[a]) / s.d[a];
                 let (u, v) = (s.p0[b] + k * s.d[b], s.p0[c] + k * s.d[c]);

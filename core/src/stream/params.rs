@@ -9,7 +9,7 @@ pub struct StreamParams {
     pub origin_cell_fraction: f32,
     /// Direction cell size as a fraction of a cube face's side: directions are quantized on the
     /// face of the unit cube they point through, so the rays of one cell share their dominant
-    /// axis (the frustum's). 1/128 by default.
+    /// axis (the frustum's). 1/16 by default.
     pub direction_cell_fraction: f32,
     /// Most rays per packet (the paper's MaxSize; 256 by default).
     pub max_packet: u32,
@@ -17,7 +17,7 @@ pub struct StreamParams {
 
 impl Default for StreamParams {
     fn default() -> Self {
-        Self { origin_cell_fraction: 0.004, direction_cell_fraction: 1.0 / 128.0, max_packet: 256 }
+        Self { origin_cell_fraction: 0.004, direction_cell_fraction: 1.0 / 16.0, max_packet: 256 }
     }
 }
 

@@ -1,13 +1,12 @@
 //! Breadth-first frustum traversal (Garanzha & Loop 2010, Sec. 3.3, Fig. 9): a queue of (frustum,
 //! node) pairs is expanded a level at a time. Each pair tests its node's children against its
-//! frustum and counts the hits; an exclusive scan of the counts places each pair's hit children,
-//! nearest side first, in the next queue. Leaves reached early are carried down unchanged (the
+//! frustum; its hit children, nearest side first, take its place in the next queue, in order (the
+//! paper places them by an exclusive scan of the counts; see [`PAIRS_PER_ITEM`]). Leaves reached early are carried down unchanged (the
 //! paper's "children of themselves"), so the final queue holds, per frustum, its leaves in order.
 
 use super::exec::Parallel;
 use super::frustum::{Frustum, FrustumTest};
 use super::levels::LevelNode;
-use super::scan::exclusive_scan;
 use super::sort::compress;
 use alloc::vec;
 use alloc::vec::Vec;
@@ -63,6 +62,19 @@ pub fn expand_pair<F: FrustumTest>(nodes: &[LevelNode], frustum: &Frustum, node:
     count as u32
 }
 
+/// Pairs expanded per work item: each item expands a run of consecutive pairs into its own output,
+/// and the runs' outputs are concatenated in order. This is the scan-and-scatter of the paper with
+/// the scan in two levels (within a run, then over the runs' sizes), which lets a CPU write each
+/// run's output in one sweep instead of through a per-pair count array.
+pub const PAIRS_PER_ITEM: usize = 2048;
+
+/// One run's output: its pairs in order, whether any is an internal node, and its box tests.
+struct Expanded {
+    pairs: PairQueue,
+    internal: bool,
+    box_tests: u64,
+}
+
 /// Traverses the level-order tree with every frustum, starting each with active rays at the root
 /// (node 0), until only leaves remain; then compresses the final queue by frustum into ranges.
 pub fn traverse<P: Parallel, F: FrustumTest>(exec: &P, nodes: &[LevelNode], frustums: &[Frustum]) -> LeafLists {
@@ -74,24 +86,33 @@ pub fn traverse<P: Parallel, F: FrustumTest>(exec: &P, nodes: &[LevelNode], frus
         }
     }
     let mut out = LeafLists::default();
-    while queue.node.iter().any(|&n| !nodes[n as usize].is_leaf()) {
+    let mut internal = queue.node.iter().any(|&n| !nodes[n as usize].is_leaf());
+    while internal {
         out.queue_sizes.push(queue.node.len() as u32);
-        out.box_tests += queue.node.iter().map(|&n| u64::from(nodes[n as usize].children())).sum::<u64>();
-        let expanded: Vec<(u32, [u32; 8])> = exec.map(queue.node.len(), |i| {
+        let runs = exec.map(queue.node.len().div_ceil(PAIRS_PER_ITEM), |r| {
+            let range = r * PAIRS_PER_ITEM..((r + 1) * PAIRS_PER_ITEM).min(queue.node.len());
+            let mut e = Expanded { pairs: PairQueue::default(), internal: false, box_tests: 0 };
             let mut children = [0u32; 8];
-            let f = queue.frustum[i];
-            let count = expand_pair::<F>(nodes, &frustums[f as usize], queue.node[i], &mut children);
-            (count, children)
-        });
-        let counts: Vec<u32> = expanded.iter().map(|e| e.0).collect();
-        let (offsets, total) = exclusive_scan(&counts);
-        let mut next = PairQueue { frustum: vec![0; total as usize], node: vec![0; total as usize] };
-        for (i, (count, children)) in expanded.iter().enumerate() {
-            let at = offsets[i] as usize;
-            for k in 0..*count as usize {
-                next.frustum[at + k] = queue.frustum[i];
-                next.node[at + k] = children[k];
+            for i in range {
+                let f = queue.frustum[i];
+                e.box_tests += u64::from(nodes[queue.node[i] as usize].children());
+                let count = expand_pair::<F>(nodes, &frustums[f as usize], queue.node[i], &mut children);
+                for &child in &children[..count as usize] {
+                    e.internal |= !nodes[child as usize].is_leaf();
+                    e.pairs.frustum.push(f);
+                    e.pairs.node.push(child);
+                }
             }
+            e
+        });
+        let total = runs.iter().map(|e| e.pairs.node.len()).sum();
+        let mut next = PairQueue { frustum: Vec::with_capacity(total), node: Vec::with_capacity(total) };
+        internal = false;
+        for e in runs {
+            next.frustum.extend_from_slice(&e.pairs.frustum);
+            next.node.extend_from_slice(&e.pairs.node);
+            internal |= e.internal;
+            out.box_tests += e.box_tests;
         }
         queue = next;
     }
