@@ -115,15 +115,15 @@ fn print_stream_stages(r: &RayReport) {
         return;
     }
     println!(
-        "  stream stages, ms (one untimed pass):  {:>7} {:>9} {:>9} {:>12}  {:>8} {:>8} {:>9} {:>9}",
-        "sort", "frustums", "traversal", "intersection", "packets", "rays/pk", "leaves/pk", "work MB"
+        "  stream stages, ms (one untimed pass):  {:>7} {:>9} {:>9} {:>12}  {:>8} {:>8} {:>9} {:>8} {:>9}",
+        "sort", "frustums", "traversal", "intersection", "packets", "rays/pk", "leaves/pk", "longest", "work MB"
     );
     for row in rows {
         let Some(st) = &row.stream else { continue };
         let ms = |s: f64| s * 1e3;
         let per = |x: usize| x as f64 / st.packets.max(1) as f64;
         println!(
-            "  {:<38} {:>7.1} {:>9.1} {:>9.1} {:>12.1}  {:>8} {:>8.1} {:>9.1} {:>9.1}",
+            "  {:<38} {:>7.1} {:>9.1} {:>9.1} {:>12.1}  {:>8} {:>8.1} {:>9.1} {:>8} {:>9.1}",
             row.target,
             ms(st.seconds.sort),
             ms(st.seconds.frustums),
@@ -132,6 +132,7 @@ fn print_stream_stages(r: &RayReport) {
             thousands(st.packets as u64),
             per(r.rays),
             per(st.leaf_refs),
+            st.largest_list,
             mb(st.working_bytes)
         );
     }

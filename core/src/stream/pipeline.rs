@@ -44,6 +44,9 @@ pub struct StreamStats {
     pub queue_sizes: Vec<u32>,
     /// Leaf references over all frustums (the paper's LS; `packets` is its FS).
     pub leaf_refs: usize,
+    /// The longest leaf list of one frustum (the paper's bad case is one frustum holding most
+    /// leaf references).
+    pub largest_list: usize,
     /// Frustum-box tests.
     pub box_tests: u64,
     /// Peak bytes of the working arrays (keys, order, packet bounds, frustums, two queues).
@@ -180,6 +183,7 @@ pub fn trace_stream<P: Parallel, F: FrustumTest, T: TriangleTest, K: ChildKernel
         active_frustums: plan.frustums.iter().filter(|f| f.active > 0).count(),
         queue_sizes: lists.queue_sizes.clone(),
         leaf_refs: lists.pairs.node.len(),
+        largest_list: lists.ranges.iter().map(|r| r[1] as usize).max().unwrap_or(0),
         box_tests: lists.box_tests,
         working_bytes: 4 * (2 * rays.len() + plan.packets.len())
             + plan.frustums.len() * core::mem::size_of::<Frustum>()

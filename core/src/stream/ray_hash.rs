@@ -13,10 +13,12 @@ pub const UNTRACEABLE_KEY: u32 = u32::MAX;
 
 /// The two virtual grids: origins over the scene box, directions over the faces of the unit cube.
 ///
-/// The paper leaves open how the two cell ids are merged into 32 bits. Here the exact cell pair
-/// is the key when the grids have at most 2^32 cell pairs; otherwise the pair is hashed to 32 bits
-/// by a fixed mixing function. A collision merely puts two cells' rays into one packet, whose
-/// frustum then bounds both: slower, never wrong.
+/// The paper leaves open how the two cell ids are merged into 32 bits. Here the key is the cell
+/// pair itself, direction cell above origin cell, so two rays share a key only when they share
+/// both cells. Where the pair needs more than 32 bits, the origin grid is coarsened a Morton level
+/// at a time (the lowest three bits of its code dropped: cells twice as wide) until it fits. A
+/// hash of the pair would keep the cells but let unrelated rays collide into one packet, and one
+/// such packet of three diffuse rays on the dragon had a frustum over 80,000 leaves.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayGrid {
     /// Lower corner of the origin grid (the scene box's).
@@ -31,8 +33,9 @@ pub struct RayGrid {
     pub dir_cells: u32,
     /// Bits of a position on a face (2 per bit of `dir_cells - 1`).
     pub face_bits: u32,
-    /// Whether the cell pair fits 32 bits as it is (else it is mixed down to 32).
-    pub exact: bool,
+    /// Low bits of the origin cell's Morton code dropped so the pair fits 32 bits (a multiple of
+    /// three; 0 where it fits as it is).
+    pub origin_drop: u32,
 }
 
 impl RayGrid {
@@ -40,7 +43,8 @@ impl RayGrid {
     pub fn new(scene: &Aabb, params: &StreamParams) -> RayGrid {
         let extent = scene.extent().max(Vec3::ZERO);
         let diagonal = extent.length();
-        let cell = params.origin_cell_fraction * diagonal;
+        // Cells at least 1/1024 of the longest side, so that every axis fits its 10 bits.
+        let cell = (params.origin_cell_fraction * diagonal).max(extent.max_element() / MAX_CELLS as f32);
         let inv_cell = if cell > 0.0 && cell.is_finite() { 1.0 / cell } else { 0.0 };
         let per_axis = |e: f32| ((e * inv_cell).ceil() as u32).clamp(1, MAX_CELLS);
         let cells = [per_axis(extent.x), per_axis(extent.y), per_axis(extent.z)];
@@ -49,9 +53,10 @@ impl RayGrid {
         let dir_cells = ((1.0 / params.direction_cell_fraction).ceil() as u32).clamp(1, MAX_CELLS);
         let face_bits = 2 * (u32::BITS - (dir_cells - 1).leading_zeros());
         // Six faces need three bits above the position on the face.
-        let exact = 3 + face_bits + origin_bits <= 32;
+        let over = (3 + face_bits + origin_bits).saturating_sub(32);
+        let origin_drop = over.div_ceil(3) * 3;
         let lo = if scene.is_empty() { Vec3::ZERO } else { scene.min };
-        RayGrid { lo, inv_cell, cells, origin_bits, dir_cells, face_bits, exact }
+        RayGrid { lo, inv_cell, cells, origin_bits, dir_cells, face_bits, origin_drop }
     }
 
     /// The ray's 32-bit key ([`UNTRACEABLE_KEY`] for a ray that cannot be traced).
@@ -63,9 +68,9 @@ impl RayGrid {
         // `as u32` saturates (and maps NaN to 0), so origins outside the box land in its border cells.
         let cell = |x: f32, n: u32| (x as u32).min(n - 1);
         let origin = morton3(cell(rel.x, self.cells[0]), cell(rel.y, self.cells[1]), cell(rel.z, self.cells[2]));
-        let id = (u64::from(self.direction_cell(ray.dir())) << self.origin_bits) | u64::from(origin);
-        let key = if self.exact { id as u32 } else { mix(id) };
-        // The untraceable key is reserved.
+        let kept = self.origin_bits - self.origin_drop;
+        let key = (self.direction_cell(ray.dir()) << kept) | (origin >> self.origin_drop);
+        // The untraceable key is reserved (the largest pair is below it: 6 faces, not 8).
         key.min(UNTRACEABLE_KEY - 1)
     }
 
@@ -112,14 +117,6 @@ fn morton2(x: u32, y: u32) -> u32 {
     spread(x) | (spread(y) << 1)
 }
 
-/// A fixed 64-to-32-bit mixing function (the finalizer of splitmix64).
-fn mix(id: u64) -> u32 {
-    let mut z = id.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    (z ^ (z >> 31)) as u32
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -147,6 +144,18 @@ mod tests {
         // Far outside the box: clamped into a border cell, not wrapped around.
         let far = g.key(&Ray::new(Vec3::splat(-1e30), Vec3::X, 0.0, 1.0));
         assert_eq!(far, g.key(&Ray::new(Vec3::ZERO, Vec3::X, 0.0, 1.0)));
+    }
+
+    #[test]
+    fn a_fine_origin_grid_is_coarsened_to_fit_32_bits() {
+        let params = StreamParams { origin_cell_fraction: 1e-4, direction_cell_fraction: 1.0 / 64.0, ..StreamParams::default() };
+        let g = RayGrid::new(&Aabb::new(Vec3::ZERO, Vec3::splat(1.0)), &params);
+        assert_eq!((g.origin_bits, g.face_bits), (30, 12));
+        assert_eq!(g.origin_drop, 15, "3 + 12 + 30 - 32 = 13 bits over, rounded up to whole levels");
+        // Keys still separate faces and distant origins.
+        let r = |o: Vec3, d: Vec3| g.key(&Ray::new(o, d, 0.0, 1.0));
+        assert_ne!(r(Vec3::splat(0.2), Vec3::X), r(Vec3::splat(0.2), -Vec3::X));
+        assert_ne!(r(Vec3::splat(0.2), Vec3::X), r(Vec3::splat(0.8), Vec3::X));
     }
 
     #[test]
