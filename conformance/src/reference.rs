@@ -8,9 +8,9 @@ use raytrail_core::kd::traverse::packets::packets;
 use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, RestartPolicy, PACKET_WIDTH};
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{KdMethod, Method, Query, StreamMethod};
-use raytrail_core::stream::{trace_stream, FrustumCull, Serial};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
+use raytrail_core::stream::{trace_stream, FrustumCull, Serial};
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{ReferenceKernel, WideSliceMemory, WideTree};
@@ -119,10 +119,24 @@ impl SerialBackend {
         let enumerate = opts.record == Record::Enumerations;
         let out = match opts.triangle_test {
             TriangleTestKind::Watertight => trace_stream::<_, FrustumCull, Watertight, ReferenceKernel>(
-                &Serial, &s, rays, hits, opts.query, &opts.stream, true, enumerate,
+                &Serial,
+                &s,
+                rays,
+                hits,
+                opts.query,
+                &opts.stream,
+                true,
+                enumerate,
             ),
             TriangleTestKind::MollerTrumbore => trace_stream::<_, FrustumCull, MollerTrumbore, ReferenceKernel>(
-                &Serial, &s, rays, hits, opts.query, &opts.stream, true, enumerate,
+                &Serial,
+                &s,
+                rays,
+                hits,
+                opts.query,
+                &opts.stream,
+                true,
+                enumerate,
             ),
         }?;
         let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());

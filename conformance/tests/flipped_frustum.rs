@@ -39,8 +39,16 @@ impl<const K: usize> FrustumTest for Flipped<K> {
         let a = f.axis as usize;
         let (mut x0, mut x1) = (lo[a], hi[a]);
         // Near keeps x >= near; flipped, x <= near. Far keeps x <= far; flipped, x >= far.
-        if K == 0 { x1 = x1.min(f.near) } else { x0 = x0.max(f.near) }
-        if K == 1 { x0 = x0.max(f.far) } else { x1 = x1.min(f.far) }
+        if K == 0 {
+            x1 = x1.min(f.near)
+        } else {
+            x0 = x0.max(f.near)
+        }
+        if K == 1 {
+            x0 = x0.max(f.far)
+        } else {
+            x1 = x1.min(f.far)
+        }
         if x0 > x1 {
             return false;
         }

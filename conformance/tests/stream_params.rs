@@ -19,6 +19,9 @@ use std::sync::Arc;
 
 const STREAM: Method = Method::Stream(StreamMethod::Frustum8);
 
+/// A backend's trace: fills the hits, returns the enumerations when recorded.
+type Tracer<'a> = &'a dyn Fn(&[Ray], &TraceOptions, &mut [Hit]) -> Option<Vec<Vec<u32>>>;
+
 fn settings() -> Vec<StreamParams> {
     let d = StreamParams::default();
     vec![
@@ -33,19 +36,23 @@ fn settings() -> Vec<StreamParams> {
 fn check(scene_name: &str) {
     let named = generated_scene(scene_name);
     let bvh = SahBuilder::default().build(named.scene.triangles()).expect("build");
-    let prepared = Arc::new(PreparedScene::new(&named.scene, bvh, &[STREAM, Bvh2Method::Stack.into()]).expect("prepare"));
+    let prepared =
+        Arc::new(PreparedScene::new(&named.scene, bvh, &[STREAM, Bvh2Method::Stack.into()]).expect("prepare"));
     let serial_scene = SerialBackend.prepare(prepared.clone()).expect("prepare");
     let cpu = CpuBackend::new();
     let cpu_scene = cpu.prepare(prepared.clone()).expect("prepare");
-    let trace = |b: &dyn Fn(&[Ray], &TraceOptions, &mut [Hit]) -> Option<Vec<Vec<u32>>>, rays: &[Ray], o: TraceOptions| {
-        let mut hits = vec![Hit::MISS; rays.len()];
-        let e = b(rays, &o, &mut hits);
-        (hits, e)
-    };
+    let trace =
+        |b: &dyn Fn(&[Ray], &TraceOptions, &mut [Hit]) -> Option<Vec<Vec<u32>>>, rays: &[Ray], o: TraceOptions| {
+            let mut hits = vec![Hit::MISS; rays.len()];
+            let e = b(rays, &o, &mut hits);
+            (hits, e)
+        };
     let serial = |rays: &[Ray], o: &TraceOptions, h: &mut [Hit]| {
         SerialBackend.trace(&serial_scene, rays, o, h).expect("serial trace").enumerations
     };
-    let on_cpu = |rays: &[Ray], o: &TraceOptions, h: &mut [Hit]| cpu.trace(&cpu_scene, rays, o, h).expect("cpu trace").enumerations;
+    let on_cpu = |rays: &[Ray], o: &TraceOptions, h: &mut [Hit]| {
+        cpu.trace(&cpu_scene, rays, o, h).expect("cpu trace").enumerations
+    };
     let mut closest = |rays: &[Ray]| trace(&serial, rays, TraceOptions::new(Bvh2Method::Stack)).0;
     let sets = ray_sets(&named.scene, RaySetSize { width: 40, height: 30, uniform_count: 1500 }, &mut closest);
     let leaves = leaf_of_prim(&prepared.bvh);
@@ -62,13 +69,22 @@ fn check(scene_name: &str) {
                         Query::Closest => a.same_as(b),
                         Query::Any => a.is_hit() == b.is_hit(),
                     };
-                    assert!(same(r, s) && same(r, c), "{what}: ray {i}: stack {r:?}, serial stream {s:?}, cpu stream {c:?}");
+                    assert!(
+                        same(r, s) && same(r, c),
+                        "{what}: ray {i}: stack {r:?}, serial stream {s:?}, cpu stream {c:?}"
+                    );
                 }
                 assert_eq!(serial_enum, cpu_enum, "{what}: the CPU's enumerations differ from the serial reference's");
                 if query == Query::Closest {
                     let ctx = Context { scene: scene_name, ray_set: set.kind.name(), backend: "cpu" };
-                    let gaps = check_complete(ctx, &set.rays, STREAM, &reference, &cpu_enum.unwrap_or_default(), &leaves);
-                    assert!(gaps.is_empty(), "{what}: {} rays' leaf lists lack their hit's leaf:\n{}", gaps.len(), gaps[0]);
+                    let gaps =
+                        check_complete(ctx, &set.rays, STREAM, &reference, &cpu_enum.unwrap_or_default(), &leaves);
+                    assert!(
+                        gaps.is_empty(),
+                        "{what}: {} rays' leaf lists lack their hit's leaf:\n{}",
+                        gaps.len(),
+                        gaps[0]
+                    );
                 }
             }
         }

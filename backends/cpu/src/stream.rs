@@ -5,6 +5,7 @@ use rayon::prelude::*;
 use raytrail_core::intersect::{MollerTrumbore, Watertight};
 use raytrail_core::method::StreamMethod;
 use raytrail_core::prepared::PreparedScene;
+use raytrail_core::stream::sort::Chunks;
 use raytrail_core::stream::{trace_stream, FrustumCull, Parallel, StreamOutput};
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::FastKernel;
@@ -25,6 +26,17 @@ impl Parallel for Rayon {
             (0..n).into_par_iter().with_min_len(64).map(f).collect()
         }
     }
+
+    /// A parallel comparison sort by (key, base): the radix sort's order (no two chunks share a
+    /// base), on both cores.
+    fn sort_chunks(&self, chunks: &mut Chunks) {
+        let mut all: Vec<(u32, u32, u32)> =
+            chunks.key.iter().zip(&chunks.base).zip(&chunks.size).map(|((&k, &b), &s)| (k, b, s)).collect();
+        all.par_sort_unstable_by_key(|&(k, b, _)| (k, b));
+        for (i, (k, b, s)) in all.into_iter().enumerate() {
+            (chunks.key[i], chunks.base[i], chunks.size[i]) = (k, b, s);
+        }
+    }
 }
 
 /// Traces the whole batch (call inside the backend's pool).
@@ -39,10 +51,24 @@ pub(crate) fn trace(
     let (count, enumerate) = (opts.record != Record::Nothing, opts.record == Record::Enumerations);
     match opts.triangle_test {
         TriangleTestKind::Watertight => trace_stream::<_, FrustumCull, Watertight, FastKernel>(
-            &Rayon, &s, rays, hits, opts.query, &opts.stream, count, enumerate,
+            &Rayon,
+            &s,
+            rays,
+            hits,
+            opts.query,
+            &opts.stream,
+            count,
+            enumerate,
         ),
         TriangleTestKind::MollerTrumbore => trace_stream::<_, FrustumCull, MollerTrumbore, FastKernel>(
-            &Rayon, &s, rays, hits, opts.query, &opts.stream, count, enumerate,
+            &Rayon,
+            &s,
+            rays,
+            hits,
+            opts.query,
+            &opts.stream,
+            count,
+            enumerate,
         ),
     }
 }

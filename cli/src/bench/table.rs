@@ -105,9 +105,11 @@ fn print_stream_stages(r: &RayReport) {
         let mut seen: Vec<&str> = Vec::new();
         r.rows
             .iter()
-            .filter(|row| row.stream.is_some() && !seen.contains(&row.target.as_str()) && {
-                seen.push(&row.target);
-                true
+            .filter(|row| {
+                row.stream.is_some() && !seen.contains(&row.target.as_str()) && {
+                    seen.push(&row.target);
+                    true
+                }
             })
             .collect()
     };

@@ -114,7 +114,13 @@ pub struct RaytrailCpu {
 impl RaytrailCpu {
     /// The target tracing `method` over `scene`.
     pub fn new(method: Method, scene: CpuScene) -> Self {
-        Self { method, name: method.name().to_string(), stream: StreamParams::default(), backend: CpuBackend::new(), scene }
+        Self {
+            method,
+            name: method.name().to_string(),
+            stream: StreamParams::default(),
+            backend: CpuBackend::new(),
+            scene,
+        }
     }
 
     /// The stream method with `params`, named `stream` for the defaults and
@@ -173,7 +179,12 @@ impl BenchTarget for RaytrailCpu {
         Ok(Some(Work { nodes: per_ray(c.nodes()), leaves: per_ray(c.leaves), tests: per_ray(c.primitive_tests) }))
     }
 
-    fn stream_stats(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<StreamStats>, String> {
+    fn stream_stats(
+        &self,
+        pool: &rayon::ThreadPool,
+        rays: &[Ray],
+        query: Query,
+    ) -> Result<Option<StreamStats>, String> {
         if self.method.stream().is_none() {
             return Ok(None);
         }

@@ -90,7 +90,8 @@ impl Method {
     /// Every method: the BVH2 methods, the kd methods, the wide methods, then the stream methods.
     pub const ALL: [Method; Method::BVH2.len() + Method::KD.len() + Method::WIDE.len() + Method::STREAM.len()] = {
         let (b, k, w) = (Method::BVH2.len(), Method::KD.len(), Method::WIDE.len());
-        let mut out = [Method::Bvh2(Bvh2Method::Stack); Method::BVH2.len() + Method::KD.len() + Method::WIDE.len() + Method::STREAM.len()];
+        let mut out = [Method::Bvh2(Bvh2Method::Stack);
+            Method::BVH2.len() + Method::KD.len() + Method::WIDE.len() + Method::STREAM.len()];
         let mut i = 0;
         while i < out.len() {
             out[i] = if i < b {
@@ -279,7 +280,10 @@ mod tests {
             assert_eq!(Method::from_name(m.name()), Some(m));
         }
         assert_eq!(Method::from_name("nope"), None);
-        assert_eq!(Method::BVH2.len() + Method::KD.len() + Method::WIDE.len() + Method::STREAM.len(), Method::ALL.len());
+        assert_eq!(
+            Method::BVH2.len() + Method::KD.len() + Method::WIDE.len() + Method::STREAM.len(),
+            Method::ALL.len()
+        );
         assert_eq!((Method::ALL[0], Method::ALL[7]), (Method::Bvh2(Bvh2Method::Stack), Method::Kd(KdMethod::Stack)));
     }
 

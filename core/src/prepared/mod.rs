@@ -11,8 +11,8 @@ use crate::kd::traverse::KdRoot;
 use crate::kd::{KdBuilder, KdSliceMemory, KdTree};
 use crate::key::KeyWidth;
 use crate::method::{Bvh2Method, Method, StreamMethod, Structure, WideMethod};
-use crate::stream::{LevelBvh, StreamScene};
 use crate::scene::Scene;
+use crate::stream::{LevelBvh, StreamScene};
 use crate::wide::traverse::WideRoot;
 use crate::wide::{WideBvh, WideTree};
 use crate::Error;
@@ -252,7 +252,10 @@ impl PreparedScene {
 
     /// What `method` traverses: the level-order tree with the scene box and scale.
     pub fn stream_scene(&self, method: StreamMethod) -> Result<StreamScene<'_>, Error> {
-        let tree = self.levels.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "the level-order tree" })?;
+        let tree = self
+            .levels
+            .as_ref()
+            .ok_or(Error::NotPrepared { method: method.name(), missing: "the level-order tree" })?;
         Ok(StreamScene { tree, bounds: self.bvh.nodes()[0].bounds, scene_scale: self.scene_scale() })
     }
 

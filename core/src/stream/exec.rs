@@ -6,6 +6,13 @@
 pub trait Parallel: Sync {
     /// `f(0), f(1), ..., f(n - 1)`, in that order.
     fn map<T: Send>(&self, n: usize, f: impl Fn(usize) -> T + Sync + Send) -> alloc::vec::Vec<T>;
+
+    /// Sorts chunks by key, equal keys by base: the order the stable radix sort of
+    /// [`radix_sort`](super::sort::radix_sort) gives, which is the default. Since no two chunks
+    /// share a base, any correct sort by (key, base) gives the same result.
+    fn sort_chunks(&self, chunks: &mut super::sort::Chunks) {
+        super::sort::radix_sort(chunks);
+    }
 }
 
 /// Every item on the calling thread.

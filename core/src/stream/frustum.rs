@@ -147,7 +147,8 @@ impl Frustum {
         let m = reach * MARGIN;
         let (lo, hi) = (lo - m, hi + m);
         let dir_signs = u32::from(mean.x < 0.0) | u32::from(mean.y < 0.0) << 1 | u32::from(mean.z < 0.0) << 2;
-        let mut f = Frustum { lo: lo.to_array(), axis: NO_AXIS, hi: hi.to_array(), active, dir_signs, ..Frustum::EMPTY };
+        let mut f =
+            Frustum { lo: lo.to_array(), axis: NO_AXIS, hi: hi.to_array(), active, dir_signs, ..Frustum::EMPTY };
         if !(lo.is_finite() && hi.is_finite()) {
             // Segments beyond the f32 range: nothing is culled.
             (f.lo, f.hi) = ([f32::NEG_INFINITY; 3], [f32::INFINITY; 3]);

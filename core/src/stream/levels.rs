@@ -115,7 +115,8 @@ impl LevelBvh {
                 if children.is_empty() {
                     return Err(Error::MalformedTree("a wide node without children"));
                 }
-                let first = u32::try_from(nodes.len()).map_err(|_| Error::TreeTooLarge { what: "nodes", size: nodes.len() })?;
+                let first =
+                    u32::try_from(nodes.len()).map_err(|_| Error::TreeTooLarge { what: "nodes", size: nodes.len() })?;
                 let mut info = children.len() as u32;
                 for (k, &(octant, slot)) in children.iter().enumerate() {
                     info |= octant << (8 + 3 * k);
@@ -133,7 +134,8 @@ impl LevelBvh {
             }
             i += 1;
         }
-        let mut level_starts: Vec<u32> = (0..nodes.len()).filter(|&i| i == 0 || depth[i] != depth[i - 1]).map(|i| i as u32).collect();
+        let mut level_starts: Vec<u32> =
+            (0..nodes.len()).filter(|&i| i == 0 || depth[i] != depth[i - 1]).map(|i| i as u32).collect();
         level_starts.push(nodes.len() as u32);
         let canonical = wide.iter().map(|c| tree.canonical_id(c.node_ref()).unwrap_or(u32::MAX)).collect();
         Ok(LevelBvh {

@@ -9,11 +9,11 @@ use crate::method::Query;
 use crate::observe::Observer;
 use crate::traverse::begin;
 use crate::wide::{ChildKernel, WideChild, WideNode};
-use alloc::vec::Vec;
 use crate::{Hit, Ray};
+use alloc::vec::Vec;
 
-/// Traces the rays `ids` (indices into `rays`) against the leaves `leaves` (node indices, in
-/// order) into `hits` (one per id, in the same order). Leaves are tested with the wide traversal's
+/// Traces `rays` (a packet's, in sorted order) against the leaves `leaves` (node indices, in
+/// order) into `hits` (one per ray). Leaves are tested with the wide traversal's
 /// leaf test, four triangles at a time where `K` says so, and report to `obs` as in the wide
 /// traversal: a leaf entered, each triangle tested, each hit taken.
 ///
@@ -21,19 +21,41 @@ use crate::{Hit, Ray};
 /// at once with `K`'s child test over its interval at the start of the eight; a box is tested again
 /// alone, over the shorter interval, where a hit in an earlier leaf of the eight has moved the
 /// limit since. So a leaf is entered exactly when the one-at-a-time mask of Fig. 10 would enter it.
+///
+/// "Closest triangles first" (Sec. 3.4): where the frustum has a dominant axis (`frustum_axis`:
+/// the axis and whether the rays run toward its negative end), the leaves are visited by their
+/// near side along it, and a ray stops at the first leaf whose near-side distance alone already
+/// exceeds what its slab test would accept: every later leaf's is at least as far. The answer is
+/// the one the list order gives (the closest hit does not depend on the order; only the work does).
 #[allow(clippy::too_many_arguments)]
 pub fn intersect_packet<T: TriangleTest, K: ChildKernel, O: Observer>(
     tree: &LevelBvh,
     leaves: &[u32],
+    frustum_axis: Option<(usize, bool)>,
     rays: &[Ray],
-    ids: &[u32],
     scene_scale: f32,
     query: Query,
     hits: &mut [Hit],
     obs: &mut O,
 ) {
     let (nodes, mem) = (tree.nodes(), tree.leaf_memory());
-    let boxes: Vec<WideNode<8>> = leaves
+    // The near side of a leaf along the axis, and the order that makes it grow.
+    let near = |leaf: u32, (a, negative): (usize, bool)| {
+        let n = &nodes[leaf as usize];
+        if negative {
+            n.hi[a]
+        } else {
+            n.lo[a]
+        }
+    };
+    let mut order: Vec<u32> = leaves.to_vec();
+    if let Some(axis) = frustum_axis {
+        let key = |leaf: u32| if axis.1 { -near(leaf, axis) } else { near(leaf, axis) };
+        order.sort_by(|&x, &y| key(x).total_cmp(&key(y)));
+    }
+    let firsts: Vec<f32> =
+        frustum_axis.map_or_else(Vec::new, |axis| order.chunks(8).map(|run| near(run[0], axis)).collect());
+    let boxes: Vec<WideNode<8>> = order
         .chunks(8)
         .map(|run| {
             let mut n = WideNode::EMPTY;
@@ -44,14 +66,25 @@ pub fn intersect_packet<T: TriangleTest, K: ChildKernel, O: Observer>(
             n
         })
         .collect();
-    for (&id, hit) in ids.iter().zip(hits.iter_mut()) {
-        let Some((ctx, mut q)) = begin::<T, NoPair>(&rays[id as usize], scene_scale, query) else {
+    for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+        let Some((ctx, mut q)) = begin::<T, NoPair>(ray, scene_scale, query) else {
             *hit = Hit::MISS;
             continue;
         };
-        'leaves: for block in &boxes {
+        // Whether this ray runs the way the leaves are ordered (every ray that enters the scene
+        // box does; one that does not misses every leaf anyway).
+        let ordered = frustum_axis.filter(|&(a, negative)| ctx.slab.negative[a] == negative).map(|(a, _)| a);
+        'leaves: for (b, block) in boxes.iter().enumerate() {
             let limit = q.limit();
             let (t0, t1) = ctx.box_interval(limit);
+            if let Some(a) = ordered {
+                // The slab test's near distance on this axis, as it computes it; beyond its
+                // acceptance bound the slab test rejects this leaf and every later one.
+                let tn = (firsts[b] - ctx.slab.origin[a]) * ctx.slab.inv_dir[a];
+                if tn > t1 + ctx.slab.slack {
+                    break;
+                }
+            }
             let mut mask = K::test::<8>(block, &ctx.slab, t0, t1).mask;
             while mask != 0 {
                 let slot = mask.trailing_zeros() as usize;

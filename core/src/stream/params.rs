@@ -29,7 +29,10 @@ impl StreamParams {
             return Err(Error::InvalidParameter { name: "origin cell fraction", why: "must be positive and finite" });
         }
         if !fraction_ok(self.direction_cell_fraction) {
-            return Err(Error::InvalidParameter { name: "direction cell fraction", why: "must be positive and finite" });
+            return Err(Error::InvalidParameter {
+                name: "direction cell fraction",
+                why: "must be positive and finite",
+            });
         }
         if self.max_packet == 0 {
             return Err(Error::InvalidParameter { name: "packet size", why: "must be at least 1" });

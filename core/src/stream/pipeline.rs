@@ -4,11 +4,11 @@
 //! backend run the same code and produce the same arrays.
 
 use super::exec::Parallel;
-use super::frustum::{Frustum, FrustumTest};
+use super::frustum::{Frustum, FrustumTest, NO_AXIS};
 use super::levels::LevelBvh;
 use super::localized::intersect_packet;
 use super::ray_hash::RayGrid;
-use super::sort::{packets, sort_by_key};
+use super::sort::{compress, decompress, packets};
 use super::traverse::{traverse, LeafLists};
 use super::StreamParams;
 use crate::intersect::TriangleTest;
@@ -62,6 +62,9 @@ pub struct StreamPlan {
     pub keys: Vec<u32>,
     /// The rays in sorted order (indices).
     pub order: Vec<u32>,
+    /// The rays themselves in sorted order: gathered once, so that the frustum and intersection
+    /// stages read each packet's rays from consecutive memory.
+    pub sorted_rays: Vec<Ray>,
     /// Packet bounds in `order`: packet `p` is `bounds[p]..bounds[p + 1]`.
     pub packets: Vec<u32>,
     /// One frustum per packet.
@@ -79,6 +82,11 @@ impl StreamPlan {
     /// The ray indices of packet `p`.
     pub fn packet(&self, p: usize) -> &[u32] {
         &self.order[self.packets[p] as usize..self.packets[p + 1] as usize]
+    }
+
+    /// The rays of packet `p`, in sorted order.
+    pub fn packet_rays(&self, p: usize) -> &[Ray] {
+        &self.sorted_rays[self.packets[p] as usize..self.packets[p + 1] as usize]
     }
 
     /// The leaves (node indices) packet `p`'s frustum reached, in order.
@@ -112,20 +120,23 @@ pub fn plan<P: Parallel, F: FrustumTest>(
     let t0 = seconds_since(None);
     let grid = RayGrid::new(&scene.bounds, params);
     let keys = exec.map(rays.len(), |i| grid.key(&rays[i]));
-    let order = sort_by_key(&keys);
+    let mut chunks = compress(&keys);
+    exec.sort_chunks(&mut chunks);
+    let order = decompress(&chunks, keys.len());
     let sorted: Vec<u32> = order.iter().map(|&i| keys[i as usize]).collect();
     let bounds = packets(&sorted, params.max_packet);
+    let sorted_rays = exec.map(order.len(), |i| rays[order[i] as usize]);
     seconds.sort = seconds_since(Some(t0));
     let t1 = seconds_since(None);
     let frustums = exec.map(bounds.len().saturating_sub(1), |p| {
-        let ids = &order[bounds[p] as usize..bounds[p + 1] as usize];
-        Frustum::build(ids.iter().map(|&i| &rays[i as usize]), &scene.bounds, scene.scene_scale)
+        let packet = &sorted_rays[bounds[p] as usize..bounds[p + 1] as usize];
+        Frustum::build(packet.iter(), &scene.bounds, scene.scene_scale)
     });
     seconds.frustums = seconds_since(Some(t1));
     let t2 = seconds_since(None);
     let lists = traverse::<P, F>(exec, scene.tree.nodes(), &frustums);
     seconds.traversal = seconds_since(Some(t2));
-    Ok(StreamPlan { keys, order, packets: bounds, frustums, lists })
+    Ok(StreamPlan { keys, order, sorted_rays, packets: bounds, frustums, lists })
 }
 
 /// What [`trace_stream`] returns besides the hits.
@@ -159,9 +170,9 @@ pub fn trace_stream<P: Parallel, F: FrustumTest, T: TriangleTest, K: ChildKernel
     let plan = plan::<P, F>(exec, scene, rays, params, &mut seconds)?;
     let t3 = seconds_since(None);
     let counters = if count {
-        Some(intersect_all::<P, T, K, Counters>(exec, scene, &plan, rays, query, hits))
+        Some(intersect_all::<P, T, K, Counters>(exec, scene, &plan, query, hits))
     } else {
-        intersect_all::<P, T, K, NoObserver>(exec, scene, &plan, rays, query, hits);
+        intersect_all::<P, T, K, NoObserver>(exec, scene, &plan, query, hits);
         None
     };
     seconds.intersection = seconds_since(Some(t3));
@@ -198,15 +209,25 @@ fn intersect_all<P: Parallel, T: TriangleTest, K: ChildKernel, O: Observer + Def
     exec: &P,
     scene: &StreamScene<'_>,
     plan: &StreamPlan,
-    rays: &[Ray],
     query: Query,
     hits: &mut [Hit],
 ) -> O {
     let per_packet = exec.map(plan.packet_count(), |p| {
-        let ids = plan.packet(p);
-        let mut out = vec![Hit::MISS; ids.len()];
+        let packet = plan.packet_rays(p);
+        let mut out = vec![Hit::MISS; packet.len()];
         let mut obs = O::default();
-        intersect_packet::<T, K, O>(scene.tree, plan.leaves(p), rays, ids, scene.scene_scale, query, &mut out, &mut obs);
+        let f = &plan.frustums[p];
+        let axis = (f.axis != NO_AXIS).then(|| (f.axis as usize, f.dir_signs >> f.axis & 1 == 1));
+        intersect_packet::<T, K, O>(
+            scene.tree,
+            plan.leaves(p),
+            axis,
+            packet,
+            scene.scene_scale,
+            query,
+            &mut out,
+            &mut obs,
+        );
         (out, obs)
     });
     let mut total = O::default();

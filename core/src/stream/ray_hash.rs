@@ -148,7 +148,8 @@ mod tests {
 
     #[test]
     fn a_fine_origin_grid_is_coarsened_to_fit_32_bits() {
-        let params = StreamParams { origin_cell_fraction: 1e-4, direction_cell_fraction: 1.0 / 64.0, ..StreamParams::default() };
+        let params =
+            StreamParams { origin_cell_fraction: 1e-4, direction_cell_fraction: 1.0 / 64.0, ..StreamParams::default() };
         let g = RayGrid::new(&Aabb::new(Vec3::ZERO, Vec3::splat(1.0)), &params);
         assert_eq!((g.origin_bits, g.face_bits), (30, 12));
         assert_eq!(g.origin_drop, 15, "3 + 12 + 30 - 32 = 13 bits over, rounded up to whole levels");

@@ -144,7 +144,11 @@ mod tests {
         let keys: Vec<u32> = (0..5000)
             .map(|i| {
                 rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                if i % 7 < 3 { 42 } else { (rng >> 32) as u32 }
+                if i % 7 < 3 {
+                    42
+                } else {
+                    (rng >> 32) as u32
+                }
             })
             .collect();
         let mut expected: Vec<u32> = (0..keys.len() as u32).collect();
