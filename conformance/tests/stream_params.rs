@@ -41,12 +41,11 @@ fn check(scene_name: &str) {
     let serial_scene = SerialBackend.prepare(prepared.clone()).expect("prepare");
     let cpu = CpuBackend::new();
     let cpu_scene = cpu.prepare(prepared.clone()).expect("prepare");
-    let trace =
-        |b: &dyn Fn(&[Ray], &TraceOptions, &mut [Hit]) -> Option<Vec<Vec<u32>>>, rays: &[Ray], o: TraceOptions| {
-            let mut hits = vec![Hit::MISS; rays.len()];
-            let e = b(rays, &o, &mut hits);
-            (hits, e)
-        };
+    let trace = |b: Tracer<'_>, rays: &[Ray], o: TraceOptions| {
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let e = b(rays, &o, &mut hits);
+        (hits, e)
+    };
     let serial = |rays: &[Ray], o: &TraceOptions, h: &mut [Hit]| {
         SerialBackend.trace(&serial_scene, rays, o, h).expect("serial trace").enumerations
     };
