@@ -1,6 +1,6 @@
 //! The stream method conforms at every parameter setting, not only the defaults: packets of one
 //! ray and of thousands, origin cells from a millionth of the scene to all of it, direction cells
-//! from a whole cube face to a thousandth. Hits equal the stack method's bit for bit (any hit:
+//! from a whole cube face to a thousandth, leaf lists intersected whole or in pieces of one leaf. Hits equal the stack method's bit for bit (any hit:
 //! the same occlusion), the CPU backend's enumerations equal the serial reference's, and every
 //! packet's leaf list holds the leaf of each of its rays' closest hits.
 
@@ -26,10 +26,12 @@ fn settings() -> Vec<StreamParams> {
     let d = StreamParams::default();
     vec![
         StreamParams { max_packet: 1, ..d },
+        StreamParams { split_leaves: 3, ..d },
+        StreamParams { split_leaves: 1, max_packet: 1024, origin_cell_fraction: 0.5, ..d },
         StreamParams { max_packet: 7, origin_cell_fraction: 1e-6, ..d },
-        StreamParams { max_packet: 4096, origin_cell_fraction: 1.0, direction_cell_fraction: 1.0 },
+        StreamParams { max_packet: 4096, origin_cell_fraction: 1.0, direction_cell_fraction: 1.0, ..d },
         StreamParams { direction_cell_fraction: 1.0 / 1024.0, ..d },
-        StreamParams { origin_cell_fraction: 0.05, direction_cell_fraction: 0.5, max_packet: 64 },
+        StreamParams { origin_cell_fraction: 0.05, direction_cell_fraction: 0.5, max_packet: 64, ..d },
     ]
 }
 

@@ -13,11 +13,15 @@ pub struct StreamParams {
     pub direction_cell_fraction: f32,
     /// Most rays per packet (the paper's MaxSize; 256 by default).
     pub max_packet: u32,
+    /// Leaf lists longer than this are intersected in pieces of this many leaves, in parallel,
+    /// and merged by the closest-hit rule (the paper's remedy for a frustum that captures most
+    /// leaves, Sec. 5.5); 8192 by default.
+    pub split_leaves: u32,
 }
 
 impl Default for StreamParams {
     fn default() -> Self {
-        Self { origin_cell_fraction: 0.004, direction_cell_fraction: 1.0 / 16.0, max_packet: 256 }
+        Self { origin_cell_fraction: 0.004, direction_cell_fraction: 1.0 / 16.0, max_packet: 256, split_leaves: 8192 }
     }
 }
 
@@ -37,13 +41,21 @@ impl StreamParams {
         if self.max_packet == 0 {
             return Err(Error::InvalidParameter { name: "packet size", why: "must be at least 1" });
         }
+        if self.split_leaves == 0 {
+            return Err(Error::InvalidParameter { name: "leaf-list piece size", why: "must be at least 1" });
+        }
         Ok(())
     }
 }
 
 impl StreamParams {
-    fn bits(&self) -> (u32, u32, u32) {
-        (self.origin_cell_fraction.to_bits(), self.direction_cell_fraction.to_bits(), self.max_packet)
+    fn bits(&self) -> (u32, u32, u32, u32) {
+        (
+            self.origin_cell_fraction.to_bits(),
+            self.direction_cell_fraction.to_bits(),
+            self.max_packet,
+            self.split_leaves,
+        )
     }
 }
 

@@ -169,10 +169,11 @@ pub fn trace_stream<P: Parallel, F: FrustumTest, T: TriangleTest, K: ChildKernel
     let mut seconds = StageSeconds::default();
     let plan = plan::<P, F>(exec, scene, rays, params, &mut seconds)?;
     let t3 = seconds_since(None);
+    let split = params.split_leaves as usize;
     let counters = if count {
-        Some(intersect_all::<P, T, K, Counters>(exec, scene, &plan, query, hits))
+        Some(intersect_all::<P, T, K, Counters>(exec, scene, &plan, query, split, hits))
     } else {
-        intersect_all::<P, T, K, NoObserver>(exec, scene, &plan, query, hits);
+        intersect_all::<P, T, K, NoObserver>(exec, scene, &plan, query, split, hits);
         None
     };
     seconds.intersection = seconds_since(Some(t3));
@@ -205,14 +206,29 @@ pub fn trace_stream<P: Parallel, F: FrustumTest, T: TriangleTest, K: ChildKernel
 }
 
 /// Stage four over every packet, the hits put back in ray order; the observers' sum.
+///
+/// A leaf list longer than `split` is intersected in pieces of `split` leaves, in parallel, and
+/// each ray's results merged by the closest-hit rule: the paper's remedy (Sec. 5.5) for a frustum
+/// that captures most of the scene's leaves, which would otherwise leave one worker with most of
+/// the stage. The answer is the same: the closest hit does not depend on the order or grouping in
+/// which candidates are offered.
 fn intersect_all<P: Parallel, T: TriangleTest, K: ChildKernel, O: Observer + Default + Send + Summed>(
     exec: &P,
     scene: &StreamScene<'_>,
     plan: &StreamPlan,
     query: Query,
+    split: usize,
     hits: &mut [Hit],
 ) -> O {
-    let per_packet = exec.map(plan.packet_count(), |p| {
+    let pieces: Vec<(usize, usize, usize)> = (0..plan.packet_count())
+        .flat_map(|p| {
+            let n = plan.leaves(p).len();
+            let count = n.div_ceil(split).max(1);
+            (0..count).map(move |k| (p, k * split, ((k + 1) * split).min(n)))
+        })
+        .collect();
+    let results = exec.map(pieces.len(), |k| {
+        let (p, from, to) = pieces[k];
         let packet = plan.packet_rays(p);
         let mut out = vec![Hit::MISS; packet.len()];
         let mut obs = O::default();
@@ -220,7 +236,7 @@ fn intersect_all<P: Parallel, T: TriangleTest, K: ChildKernel, O: Observer + Def
         let axis = (f.axis != NO_AXIS).then(|| (f.axis as usize, f.dir_signs >> f.axis & 1 == 1));
         intersect_packet::<T, K, O>(
             scene.tree,
-            plan.leaves(p),
+            &plan.leaves(p)[from..to],
             axis,
             packet,
             scene.scene_scale,
@@ -231,9 +247,13 @@ fn intersect_all<P: Parallel, T: TriangleTest, K: ChildKernel, O: Observer + Def
         (out, obs)
     });
     let mut total = O::default();
-    for (p, (packet_hits, obs)) in per_packet.into_iter().enumerate() {
-        for (&i, h) in plan.packet(p).iter().zip(packet_hits) {
-            hits[i as usize] = h;
+    for (&(p, from, _), (piece_hits, obs)) in pieces.iter().zip(results) {
+        for (&i, h) in plan.packet(p).iter().zip(piece_hits) {
+            let slot = &mut hits[i as usize];
+            // The first piece sets the hit; later ones offer theirs by the closest-hit rule.
+            if from == 0 || (h.is_hit() && (!slot.is_hit() || slot.is_beaten_by(h.t, h.prim))) {
+                *slot = h;
+            }
         }
         total.add_from(&obs);
     }
