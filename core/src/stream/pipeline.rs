@@ -49,7 +49,8 @@ pub struct StreamStats {
     pub largest_list: usize,
     /// Frustum-box tests.
     pub box_tests: u64,
-    /// Peak bytes of the working arrays (keys, order, packet bounds, frustums, two queues).
+    /// Peak bytes of the working arrays (keys, order, the rays gathered in sorted order, packet
+    /// bounds, frustums, two queues).
     pub working_bytes: usize,
     /// Time per stage.
     pub seconds: StageSeconds,
@@ -198,6 +199,7 @@ pub fn trace_stream<P: Parallel, F: FrustumTest, T: TriangleTest, K: ChildKernel
         largest_list: lists.ranges.iter().map(|r| r[1] as usize).max().unwrap_or(0),
         box_tests: lists.box_tests,
         working_bytes: 4 * (2 * rays.len() + plan.packets.len())
+            + plan.sorted_rays.len() * core::mem::size_of::<Ray>()
             + plan.frustums.len() * core::mem::size_of::<Frustum>()
             + 2 * 8 * biggest_queue,
         seconds,
