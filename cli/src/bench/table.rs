@@ -117,7 +117,7 @@ fn print_stream_stages(r: &RayReport) {
         return;
     }
     println!(
-        "  stream stages, ms (one untimed pass):  {:>7} {:>9} {:>9} {:>12}  {:>8} {:>8} {:>9} {:>8} {:>9}",
+        "  stream stages, ms (median of 3 runs):  {:>7} {:>9} {:>9} {:>12}  {:>8} {:>8} {:>9} {:>8} {:>9}",
         "sort", "frustums", "traversal", "intersection", "packets", "rays/pk", "leaves/pk", "longest", "work MB"
     );
     for row in rows {
