@@ -10,6 +10,7 @@ use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon
 use raytrail::core::method::{Bvh2Method, KdMethod, Method, Query};
 use raytrail::core::observe::Counters;
 use raytrail::core::prepared::{BuiltHash, PreparedScene};
+use raytrail::core::stream::StreamStats;
 use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::wide::WideStats;
 use raytrail::core::{Hit, Ray};
@@ -28,6 +29,8 @@ struct SetResult<'a> {
     checked: usize,
     mismatches: Vec<Mismatch>,
     gpu: Option<(Vec<f64>, Vec<Mismatch>)>,
+    /// The stream method's working figures and stages (its counted run).
+    stream: Option<StreamStats>,
 }
 
 struct RaySetRun {
@@ -79,6 +82,7 @@ pub fn main(a: RunArgs) -> Outcome {
     let mut tables = Vec::new();
     for set in &sets {
         let mut rows = Vec::new();
+        let mut stream = None;
         for method in Method::ALL {
             let mut opts = TraceOptions::new(method).query(set.query);
             let mut hits = vec![Hit::MISS; set.rays.len()];
@@ -91,6 +95,7 @@ pub fn main(a: RunArgs) -> Outcome {
             opts.record = Record::Counters;
             let counted = backend.trace(&cpu, &set.rays, &opts, &mut hits).map_err(|e| e.to_string())?;
             progress.step(&format!("{} {} counters", set.name, method));
+            stream = stream.or(counted.stream);
             rows.push((method, median(&times), counted.counters.unwrap_or_default()));
         }
         // Conformance on an evenly spread subset: recording every node of every ray is heavy.
@@ -115,7 +120,7 @@ pub fn main(a: RunArgs) -> Outcome {
             }
             None => None,
         };
-        tables.push(SetResult { set, rows, checked: subset.len(), mismatches, gpu: gpu_result });
+        tables.push(SetResult { set, rows, checked: subset.len(), mismatches, gpu: gpu_result, stream });
     }
     progress.finish();
     for t in &tables {
@@ -124,6 +129,7 @@ pub fn main(a: RunArgs) -> Outcome {
     let per_set: Vec<(&str, Vec<Row>)> = tables.iter().map(|t| (t.set.name, t.rows.clone())).collect();
     print_backtracking(&per_set);
     print_kd(&per_set);
+    print_stream(&tables);
     if failures.is_empty() {
         println!(
             "\nconformance: every method matches its reference on every checked ray (hits and node enumerations){}.",
@@ -292,6 +298,33 @@ fn print_kd(sets: &[(&str, Vec<Row>)]) {
             );
         }
         println!();
+    }
+}
+
+/// The stream method's packets, leaf lists and stages per ray set (Garanzha & Loop 2010, Table 1
+/// and Fig. 13).
+fn print_stream(tables: &[SetResult<'_>]) {
+    println!("\nstream method (Garanzha & Loop 2010): packets, frustum leaf lists and stage times (ms):");
+    println!(
+        "  {:<9} {:>8} {:>8} {:>10} {:>8} {:>7} {:>9} {:>10} {:>13}",
+        "rays", "packets", "rays/pk", "leaves/pk", "longest", "sort", "frustums", "traversal", "intersection"
+    );
+    for t in tables {
+        let Some(st) = &t.stream else { continue };
+        let per = |x: usize| x as f64 / st.packets.max(1) as f64;
+        let ms = |s: f64| format!("{:.2}", s * 1e3);
+        println!(
+            "  {:<9} {:>8} {:>8.1} {:>10.1} {:>8} {:>7} {:>9} {:>10} {:>13}",
+            t.set.name,
+            st.packets,
+            per(t.set.rays.len()),
+            per(st.leaf_refs),
+            st.largest_list,
+            ms(st.seconds.sort),
+            ms(st.seconds.frustums),
+            ms(st.seconds.traversal),
+            ms(st.seconds.intersection)
+        );
     }
 }
 
