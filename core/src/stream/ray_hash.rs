@@ -46,11 +46,11 @@ impl RayGrid {
         // Cells at least 1/1024 of the longest side, so that every axis fits its 10 bits.
         let cell = (params.origin_cell_fraction * diagonal).max(extent.max_element() / MAX_CELLS as f32);
         let inv_cell = if cell > 0.0 && cell.is_finite() { 1.0 / cell } else { 0.0 };
-        let per_axis = |e: f32| ((e * inv_cell).ceil() as u32).clamp(1, MAX_CELLS);
+        let per_axis = |e: f32| ceil_u32(e * inv_cell).clamp(1, MAX_CELLS);
         let cells = [per_axis(extent.x), per_axis(extent.y), per_axis(extent.z)];
         let widest = cells.iter().copied().max().unwrap_or(1);
         let origin_bits = 3 * (u32::BITS - (widest - 1).leading_zeros());
-        let dir_cells = ((1.0 / params.direction_cell_fraction).ceil() as u32).clamp(1, MAX_CELLS);
+        let dir_cells = ceil_u32(1.0 / params.direction_cell_fraction).clamp(1, MAX_CELLS);
         let face_bits = 2 * (u32::BITS - (dir_cells - 1).leading_zeros());
         // Six faces need three bits above the position on the face.
         let over = (3 + face_bits + origin_bits).saturating_sub(32);
@@ -90,6 +90,16 @@ impl RayGrid {
         let n = self.dir_cells;
         let cell = |x: f32| (((x + 1.0) * 0.5 * n as f32) as u32).min(n - 1);
         (face << self.face_bits) | morton2(cell(u), cell(v))
+    }
+}
+
+/// `x` rounded up to an integer, saturating (`f32::ceil` needs `std`).
+fn ceil_u32(x: f32) -> u32 {
+    let c = x as u32;
+    if (c as f32) < x {
+        c.saturating_add(1)
+    } else {
+        c
     }
 }
 
