@@ -27,14 +27,16 @@ impl Parallel for Rayon {
         }
     }
 
-    /// A parallel comparison sort by (key, base): the radix sort's order (no two chunks share a
-    /// base), on both cores.
+    /// A parallel sort of (key, chunk index) pairs packed in a `u64`: the chunks come in base
+    /// order, so this is the radix sort's order (by key, then base), on both cores.
     fn sort_chunks(&self, chunks: &mut Chunks) {
-        let mut all: Vec<(u32, u32, u32)> =
-            chunks.key.iter().zip(&chunks.base).zip(&chunks.size).map(|((&k, &b), &s)| (k, b, s)).collect();
-        all.par_sort_unstable_by_key(|&(k, b, _)| (k, b));
-        for (i, (k, b, s)) in all.into_iter().enumerate() {
-            (chunks.key[i], chunks.base[i], chunks.size[i]) = (k, b, s);
+        let mut packed: Vec<u64> =
+            chunks.key.iter().enumerate().map(|(i, &k)| u64::from(k) << 32 | i as u64).collect();
+        packed.par_sort_unstable();
+        let (base, size) = (chunks.base.clone(), chunks.size.clone());
+        for (at, &p) in packed.iter().enumerate() {
+            let i = (p & 0xffff_ffff) as usize;
+            (chunks.key[at], chunks.base[at], chunks.size[at]) = ((p >> 32) as u32, base[i], size[i]);
         }
     }
 }

@@ -50,8 +50,28 @@ pub fn intersect_packet<T: TriangleTest, K: ChildKernel, O: Observer>(
     };
     let mut order: Vec<u32> = leaves.to_vec();
     if let Some(axis) = frustum_axis {
-        let key = |leaf: u32| if axis.1 { -near(leaf, axis) } else { near(leaf, axis) };
-        order.sort_by(|&x, &y| key(x).total_cmp(&key(y)));
+        // Sorted by (near side, list position), packed in a `u64` with the float's bits made to
+        // order as integers: one sort of plain integers, no float comparisons.
+        let ordered_bits = |x: f32| {
+            let b = x.to_bits();
+            if b >> 31 == 1 {
+                !b
+            } else {
+                b | 1 << 31
+            }
+        };
+        let mut keyed: Vec<u64> = leaves
+            .iter()
+            .enumerate()
+            .map(|(i, &leaf)| {
+                let n = near(leaf, axis);
+                u64::from(ordered_bits(if axis.1 { -n } else { n })) << 32 | i as u64
+            })
+            .collect();
+        keyed.sort_unstable();
+        for (o, k) in order.iter_mut().zip(&keyed) {
+            *o = leaves[(k & 0xffff_ffff) as usize];
+        }
     }
     let firsts: Vec<f32> =
         frustum_axis.map_or_else(Vec::new, |axis| order.chunks(8).map(|run| near(run[0], axis)).collect());
