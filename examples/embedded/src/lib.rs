@@ -30,10 +30,12 @@ use raytrail_core::hash::HashShape;
 use raytrail_core::intersect::{TriangleBlock, Watertight};
 use raytrail_core::kd::traverse::{trace_kd_ray, KdRoot};
 use raytrail_core::kd::KdNode;
-use raytrail_core::observe::{NoObserver, Observer};
+pub use raytrail_core::observe::{Counters, NoObserver, Observer};
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{FastKernel, WideChild, WideNode};
 
+/// The core this example is built on, for callers that drive its traversals themselves.
+pub use raytrail_core;
 pub use grid::{grid_report, GridReport, MethodTally};
 pub use kd::KdFlashMemory;
 pub use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query, WideMethod};
@@ -315,7 +317,10 @@ impl FlashScene {
     }
 
     /// Traces one ray with any method of [`METHODS`], reporting to `obs`; `None` for a method
-    /// whose tables are not baked (the 8-wide and naive 4-wide BVHs).
+    /// whose tables are not baked (the 8-wide and naive 4-wide BVHs). Always inlined, so that a
+    /// caller with a constant method keeps only that method's code and state (one function with
+    /// every method would have the stack frame of all their states together).
+    #[inline(always)]
     pub fn trace_method<O: Observer>(&self, ray: &Ray, method: Method, query: Query, obs: &mut O) -> Option<Hit> {
         Some(match method {
             Method::Bvh2(m) => trace_ray::<u32, _, Watertight, _>(m, &self.memory(m), self.root(m), ray, query, obs),
