@@ -12,8 +12,8 @@
 use raytrail_core::bvh2::{BinaryLayout, SahBuilder, SahConfig};
 use raytrail_core::hash::PerfectHash;
 use raytrail_core::method::{Bvh2Method, KdMethod, Method, WideMethod};
-use raytrail_core::wide::{WideChild, WideTree};
 use raytrail_core::prepared::PreparedScene;
+use raytrail_core::wide::{WideChild, WideTree};
 use std::fmt::Write as _;
 use std::path::Path;
 

@@ -3,13 +3,12 @@
 use crate::measure::{milli_instructions_per_tick, paint_stack, sections, stack_used, Ticks};
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use raytrail_embedded_example::{
-    baked, grid_report, self_test, self_test_ray, FlashScene, Hit, NoObserver, Query, Ray, METHODS, SELF_TEST_RAYS,
-};
 use raytrail_embedded_example::raytrail_core::intersect::Watertight;
 use raytrail_embedded_example::raytrail_core::wide::traverse::trace_wide_batch;
 use raytrail_embedded_example::raytrail_core::wide::FastKernel;
-
+use raytrail_embedded_example::{
+    baked, grid_report, self_test, self_test_ray, FlashScene, Hit, NoObserver, Query, Ray, METHODS, SELF_TEST_RAYS,
+};
 
 #[entry]
 fn main() -> ! {

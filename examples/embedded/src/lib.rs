@@ -34,10 +34,10 @@ pub use raytrail_core::observe::{Counters, NoObserver, Observer};
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{FastKernel, WideChild, WideNode};
 
-/// The core this example is built on, for callers that drive its traversals themselves.
-pub use raytrail_core;
 pub use grid::{grid_report, GridReport, MethodTally};
 pub use kd::KdFlashMemory;
+/// The core this example is built on, for callers that drive its traversals themselves.
+pub use raytrail_core;
 pub use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query, WideMethod};
 pub use raytrail_core::{Hit, Ray};
 pub use wide::WideFlashMemory;
@@ -492,7 +492,9 @@ mod tests {
                 for m in METHODS.into_iter().filter(|m| m.bvh2().is_none()) {
                     let (mut want_c, mut got_c) = (Counters::default(), Counters::default());
                     let want = match m {
-                        Method::Kd(k) => trace_kd_ray::<_, Watertight, _>(k, &kd_mem, &kd_root, &ray, query, &mut want_c),
+                        Method::Kd(k) => {
+                            trace_kd_ray::<_, Watertight, _>(k, &kd_mem, &kd_root, &ray, query, &mut want_c)
+                        }
                         _ => trace_wide_ray::<4, _, Watertight, FastKernel, _>(
                             &wide.memory(),
                             wide_root,
