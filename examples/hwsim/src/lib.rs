@@ -13,12 +13,16 @@
 //! - [`Scenario`] builds the tree, the tables and a ray set for a scene.
 #![warn(missing_docs)]
 
+mod bvh2_lanes;
+mod kd_lanes;
 pub mod machine;
 pub mod memory;
 pub mod report;
 pub mod sim;
+mod stepper;
+mod wide_lanes;
 
-pub use memory::{CountingMemory, Table, Traffic};
+pub use memory::{CountingKdMemory, CountingMemory, CountingWideMemory, ReadTally, Table, Traffic};
 pub use sim::{simulate, CycleRecord, MethodReport, MethodRun, SimConfig, Transition};
 
 use raytrail_conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
@@ -87,11 +91,12 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    /// Builds the SAH tree of `scene`, prepares it for [`Method::BVH2`] and makes `kind` rays from a
+    /// Builds the SAH tree of `scene`, prepares it for every method ([`Method::ALL`]: the BVH2
+    /// layouts and hashes, the kd-tree, the wide trees) and makes `kind` rays from a
     /// `width` x `height` camera framing the scene (shadow and diffuse rays start at its hits).
     pub fn new(scene: Scene, kind: RayKind, width: u32, height: u32) -> Result<Scenario, String> {
         let bvh = SahBuilder::default().build(scene.triangles()).map_err(|e| e.to_string())?;
-        let prepared = PreparedScene::new(&scene, bvh, &Method::BVH2).map_err(|e| e.to_string())?;
+        let prepared = PreparedScene::new(&scene, bvh, &Method::ALL).map_err(|e| e.to_string())?;
         let camera = primary(&scene, width, height);
         let rays = match kind {
             RayKind::Primary => camera,
