@@ -144,7 +144,7 @@ fn run(a: &Args) -> Result<(), String> {
     }
     if let Some((m, cycles)) = timeline {
         println!(
-            "\nSlowest warp, {m}, one row per cycle (. idle, i internal, l leaf;\nbacktracks s pop, r register, h hash, w walk, upper case after a leaf):"
+            "\nSlowest warp, {m}, one row per cycle (. idle, i internal, l leaf;\nbacktracks s pop, r register, h hash, w walk, x restart, upper case after a leaf):"
         );
         print!("{}", report::timeline(&cycles));
     }
