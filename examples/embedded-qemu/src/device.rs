@@ -10,12 +10,57 @@ use raytrail_embedded_example::{
     baked, grid_report, self_test, self_test_ray, FlashScene, Hit, NoObserver, Query, Ray, METHODS, SELF_TEST_RAYS,
 };
 
+/// What a build runs: everything (the default), or for footprint measurements only the measuring
+/// scaffold, or the scaffold and one method (see build.rs).
+#[allow(dead_code)]
+enum Only {
+    Everything,
+    Nothing,
+    Method(usize),
+}
+
+include!(concat!(env!("OUT_DIR"), "/only.rs"));
+
+/// The method a one-method build traces (0 otherwise; unused then).
+const ONLY_METHOD: usize = match ONLY {
+    Only::Method(i) => i,
+    _ => 0,
+};
+
 #[entry]
 fn main() -> ! {
     hprintln!("raytrail-embedded-qemu: Cortex-M4F, sphereflake({}) baked into flash", baked::SPHEREFLAKE_DEPTH);
     let (text, rodata, data, bss) = sections();
     hprintln!("footprint text {} rodata {} data {} bss {} tables {}", text, rodata, data, bss, baked::TABLE_BYTES);
+    // `ONLY` is a constant, so the branches not taken, and all they call, are not linked.
+    match ONLY {
+        Only::Everything => everything(),
+        Only::Nothing => only("nothing", trace_nothing),
+        Only::Method(_) => only(METHODS[ONLY_METHOD].name(), trace_grid::<ONLY_METHOD>),
+    }
+}
 
+/// A footprint build: the scaffold and `grid` alone, one cost line, success.
+fn only(name: &str, grid: fn(&FlashScene)) -> ! {
+    let ticks = cortex_m::Peripherals::take().map(|p| Ticks::start(p.SYST));
+    let (Some(t), Ok(scene)) = (&ticks, &FlashScene::load()) else {
+        hprintln!("no SysTick, or the baked tables do not validate");
+        exit(false);
+    };
+    let per_tick = milli_instructions_per_tick(t);
+    let (milli, stack) = cost(t, scene, grid, per_tick);
+    hprintln!("only {} insns/ray {}.{} stack {}", name, milli / 1000, milli % 1000 / 100, stack);
+    exit(true)
+}
+
+/// The scaffold's grid: nothing traced.
+#[inline(never)]
+fn trace_nothing(scene: &FlashScene) {
+    core::hint::black_box(scene);
+}
+
+/// The full program: the report, the costs of every method, the self-test.
+fn everything() -> ! {
     // The digest first: every line here must equal the host's.
     let Some(report) = grid_report() else {
         hprintln!("the baked tables do not validate");
