@@ -198,3 +198,38 @@ impl Stepper for KdLanes<'_> {
         self.mem.tally().traffic()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::StepEvents;
+    use raytrail_conformance::rays::primary;
+    use raytrail_conformance::scenes::sphereflake;
+    use raytrail_core::bvh2::SahBuilder;
+    use raytrail_core::method::Query;
+
+    #[test]
+    fn a_model_that_loses_the_segment_is_caught() {
+        // The tests require zero mismatches; this shows a wrong model does not pass unnoticed.
+        let scene = sphereflake(1);
+        let bvh = SahBuilder::default().build(scene.triangles()).unwrap();
+        let prepared = PreparedScene::new(&scene, bvh, &[KdMethod::Stack.into()]).unwrap();
+        let mem = CountingKdMemory::new(prepared.kd_memory().unwrap());
+        let root = prepared.kd_root().unwrap();
+        let lanes = KdLanes { mem: &mem, root, method: KdMethod::Stack, mismatches: Cell::new(0) };
+        for ray in &primary(&scene, 16, 12) {
+            let Some(mut lane) = lanes.begin(ray) else { continue };
+            // An empty segment: the model sees every crossing as one child and pushes nothing,
+            // so the machine's first pop finds the model's stack empty.
+            lane.model.t_max = lane.model.t_min;
+            let (mut q, mut obs) = (QueryState::new(ray, Query::Closest), LaneObserver::default());
+            for _ in 0..=lanes.max_steps() {
+                obs.step = StepEvents::default();
+                if lanes.step(&mut lane, &mut q, &mut obs).step == Step::Done {
+                    break;
+                }
+            }
+        }
+        assert!(lanes.mismatches.get() > 0);
+    }
+}
