@@ -4,11 +4,16 @@
 //! builder on the target).
 //!
 //! Set `RAYTRAIL_EMBEDDED_FOOTPRINT=1` to print the flash footprint as build warnings.
+//!
+//! `RAYTRAIL_EMBEDDED_CORRUPT=FILE:WORD=HEX` replaces one 32-bit word of one baked table (say
+//! `uncle_nodes.bin:0=0x7f800000`), so a test can show that a single changed entry changes what
+//! the device computes. Never set it for a real build.
 
 use raytrail_core::bvh2::{BinaryLayout, SahBuilder, SahConfig};
 use raytrail_core::hash::PerfectHash;
-use raytrail_core::method::{Bvh2Method, Method};
+use raytrail_core::method::{Bvh2Method, KdMethod, Method, WideMethod};
 use raytrail_core::prepared::PreparedScene;
+use raytrail_core::wide::{WideChild, WideTree};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -18,10 +23,13 @@ const SPHEREFLAKE_DEPTH: u32 = 1;
 const MAX_U32_DEPTH: u32 = 31;
 /// Environment variable that turns the footprint report on.
 const FOOTPRINT_ENV: &str = "RAYTRAIL_EMBEDDED_FOOTPRINT";
+/// Environment variable that corrupts one table word (see the module docs).
+const CORRUPT_ENV: &str = "RAYTRAIL_EMBEDDED_CORRUPT";
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-env-changed={FOOTPRINT_ENV}");
+    println!("cargo:rerun-if-env-changed={CORRUPT_ENV}");
     let out_var = std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR for build scripts");
     let out = Path::new(&out_var);
 
@@ -31,9 +39,12 @@ fn main() {
     let bvh = SahBuilder::new(config).build(scene.triangles()).expect("the sphereflake builds");
     let stats = bvh.stats();
     assert!(stats.depth <= MAX_U32_DEPTH, "tree depth {} needs 64-bit keys; the example uses u32", stats.depth);
-    // Every method: the stack methods and the stackless ones share the uncle layout; only
-    // parent/sibling needs its own layout and only hash-resume the hash over every node.
-    let prepared = PreparedScene::new(&scene, bvh, &Method::BVH2).expect("the sphereflake prepares");
+    // Every BVH2 method: the stack methods and the stackless ones share the uncle layout; only
+    // parent/sibling needs its own layout and only hash-resume the hash over every node. Every
+    // kd method reads the one kd-tree; the 4-wide BVH (Guthe's pull-up) is the wide tree baked.
+    let mut methods = Method::BVH2.to_vec();
+    methods.extend([Method::Kd(KdMethod::Stack), Method::Wide(WideMethod::Bvh4)]);
+    let prepared = PreparedScene::new(&scene, bvh, &methods).expect("the sphereflake prepares");
 
     let uncles = prepared.layout(Bvh2Method::Uncle).expect("uncle layout prepared");
     let parents = prepared.layout(Bvh2Method::ParentSibling).expect("parent/sibling layout prepared");
@@ -45,6 +56,8 @@ fn main() {
         write_layout(out, "parent", parents),
         write_hash(out, "hash", hash),
         write_hash(out, "full_hash", full_hash),
+        write_kd(out, &prepared),
+        write_wide(out, &prepared),
     ];
 
     let root = prepared.root(Bvh2Method::Stack).expect("root");
@@ -86,6 +99,32 @@ fn main() {
         );
         konst(w, &format!("Cells of the {what}."), &format!("{name}_CELLS"), "usize", h.cells.len());
     }
+    let kd = prepared.kd.as_ref().expect("kd-tree prepared");
+    let kd_root = prepared.kd_root().expect("kd root");
+    let kd_stats = kd.tree.stats();
+    konst(w, "Nodes of the kd-tree (8 B each).", "KD_NODES", "usize", kd.tree.nodes().len());
+    konst(w, "Primitive references of the kd-tree's leaves.", "KD_PRIMS", "usize", kd.tree.prims().len());
+    konst(w, "Depth of the kd-tree (root: 0).", "KD_DEPTH", "u32", kd_stats.depth);
+    konst(w, "Entries of the kd short stack (Horn et al. use 3).", "KD_SHORT_STACK", "usize", kd_root.short_stack);
+    konst(w, "Step budget of a kd traversal.", "KD_MAX_STEPS", "u32", kd_root.max_steps);
+    float(w, "Scene scale of the kd methods (their box's largest magnitude).", "KD_SCENE_SCALE", kd_root.scene_scale);
+    floats(w, "Lower corner of the box the kd-tree partitions.", "KD_MIN", kd_root.lo.to_array());
+    floats(w, "Upper corner of the box the kd-tree partitions.", "KD_MAX", kd_root.hi.to_array());
+    let WideTree::Four(wide) = prepared.wide_tree(WideMethod::Bvh4).expect("wide tree") else {
+        unreachable!("bvh4 is four wide")
+    };
+    let wide_root = prepared.wide_root(WideMethod::Bvh4).expect("wide root");
+    konst(w, "Nodes of the 4-wide BVH (128 B each).", "WIDE_NODES", "usize", wide.nodes().len());
+    konst(w, "Blocks of four triangles of the 4-wide BVH.", "WIDE_BLOCKS", "usize", wide.blocks().len());
+    konst(w, "Primitive ids of the 4-wide BVH's triangle positions.", "WIDE_PRIMS", "usize", wide.prims().len());
+    konst(w, "Depth of the 4-wide BVH (root: 0).", "WIDE_DEPTH", "u32", wide.stats().depth);
+    konst(w, "Step budget of a 4-wide traversal.", "WIDE_MAX_STEPS", "u32", wide_root.max_steps);
+    let (root_child, root_count) = match wide_root.root {
+        WideChild::Node(n) => (n, 0),
+        WideChild::Leaf { first, count } => (first, count),
+    };
+    konst(w, "The 4-wide root: node index, or a leaf's first position.", "WIDE_ROOT_CHILD", "u32", root_child);
+    konst(w, "The 4-wide root's leaf count (0: the root is a node).", "WIDE_ROOT_COUNT", "u32", root_count);
     konst(
         w,
         "Bytes of all baked tables together (the flash footprint).",
@@ -109,6 +148,35 @@ fn write_layout(out: &Path, name: &str, l: &BinaryLayout) -> usize {
     nodes.len() + leaves.len()
 }
 
+/// Writes the kd-tree's nodes, primitive references and the triangles they index; returns their
+/// bytes.
+fn write_kd(out: &Path, p: &PreparedScene) -> usize {
+    let kd = p.kd.as_ref().expect("kd-tree prepared");
+    let nodes: &[u8] = bytemuck::cast_slice(kd.tree.nodes());
+    let prims: &[u8] = bytemuck::cast_slice(kd.tree.prims());
+    let tris: Vec<[f32; 9]> = kd.triangles.iter().map(|t| core::array::from_fn(|i| t.v[i / 3][i % 3])).collect();
+    let tris: &[u8] = bytemuck::cast_slice(&tris);
+    write_le(out, "kd_nodes.bin", nodes);
+    write_le(out, "kd_prims.bin", prims);
+    write_le(out, "kd_triangles.bin", tris);
+    nodes.len() + prims.len() + tris.len()
+}
+
+/// Writes the 4-wide BVH's nodes, triangle blocks and primitive ids (the traversal reads
+/// triangles four at a time, so the blocks are the only copy of them); returns their bytes.
+fn write_wide(out: &Path, p: &PreparedScene) -> usize {
+    let WideTree::Four(wide) = p.wide_tree(WideMethod::Bvh4).expect("wide tree") else {
+        unreachable!("bvh4 is four wide")
+    };
+    let nodes: &[u8] = bytemuck::cast_slice(wide.nodes());
+    let blocks: &[u8] = bytemuck::cast_slice(wide.blocks());
+    let prims: &[u8] = bytemuck::cast_slice(wide.prims());
+    write_le(out, "wide_nodes.bin", nodes);
+    write_le(out, "wide_blocks.bin", blocks);
+    write_le(out, "wide_prims.bin", prims);
+    nodes.len() + blocks.len() + prims.len()
+}
+
 /// Writes a hash's displacement and cell tables; returns their bytes.
 fn write_hash(out: &Path, name: &str, h: &PerfectHash) -> usize {
     let d: &[u8] = bytemuck::cast_slice(&h.displacement);
@@ -121,9 +189,27 @@ fn write_hash(out: &Path, name: &str, h: &PerfectHash) -> usize {
 /// Writes 32-bit words as little-endian bytes, whatever the host's byte order (every baked type
 /// is made of 4-byte words: `f32`, `u32`, `i32`).
 fn write_le(out: &Path, file: &str, native: &[u8]) {
-    let le: Vec<u8> =
-        native.chunks_exact(4).flat_map(|w| u32::from_ne_bytes([w[0], w[1], w[2], w[3]]).to_le_bytes()).collect();
+    let mut words: Vec<u32> = native.chunks_exact(4).map(|w| u32::from_ne_bytes([w[0], w[1], w[2], w[3]])).collect();
+    if let Some((word, value)) = corruption(file) {
+        let slot = words.get_mut(word).unwrap_or_else(|| panic!("{CORRUPT_ENV}: {file} has no word {word}"));
+        println!("cargo:warning={CORRUPT_ENV}: {file} word {word} changed from {:#010x} to {value:#010x}", *slot);
+        *slot = value;
+    }
+    let le: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     std::fs::write(out.join(file), le).unwrap_or_else(|e| panic!("write {file}: {e}"));
+}
+
+/// The word `RAYTRAIL_EMBEDDED_CORRUPT` replaces in `file`, if it names that file.
+fn corruption(file: &str) -> Option<(usize, u32)> {
+    let spec = std::env::var(CORRUPT_ENV).ok().filter(|s| !s.is_empty())?;
+    let parsed = spec.split_once(':').and_then(|(name, rest)| {
+        let (word, value) = rest.split_once('=')?;
+        Some((name, word.parse::<usize>().ok()?, u32::from_str_radix(value.trim_start_matches("0x"), 16).ok()?))
+    });
+    let Some((name, word, value)) = parsed else {
+        panic!("{CORRUPT_ENV}={spec}: expected FILE:WORD=HEX, e.g. uncle_nodes.bin:0=0x7f800000")
+    };
+    (name == file).then_some((word, value))
 }
 
 fn line(w: &mut String, s: &str) {
@@ -173,6 +259,23 @@ fn footprint(p: &PreparedScene, uncles: &BinaryLayout, parents: &BinaryLayout, h
         let (d, c) = (h.displacement.len() * 4, h.cells.len() * 4);
         total += d + c;
         warn(format!("{name}: displacement {d} B, cells {c} B"));
+    }
+    let kd = p.kd.as_ref().expect("kd-tree prepared");
+    let (kn, kp, kt) = (kd.tree.nodes().len() * 8, kd.tree.prims().len() * 4, kd.triangles.len() * 36);
+    total += kn + kp + kt;
+    warn(format!(
+        "kd-tree: nodes {kn} B ({} x 8), prim refs {kp} B, triangles {kt} B; depth {}",
+        kd.tree.nodes().len(),
+        kd.tree.stats().depth
+    ));
+    if let Ok(WideTree::Four(wide)) = p.wide_tree(WideMethod::Bvh4) {
+        let (wn, wb, wp) = (wide.nodes().len() * 128, wide.blocks().len() * 144, wide.prims().len() * 4);
+        total += wn + wb + wp;
+        warn(format!(
+            "4-wide BVH: nodes {wn} B ({} x 128), triangle blocks {wb} B, prim ids {wp} B; depth {}",
+            wide.nodes().len(),
+            wide.stats().depth
+        ));
     }
     warn(format!("total tables in flash: {total} B"));
     for m in Method::BVH2 {

@@ -3,22 +3,29 @@
 //!
 //! Rays are grouped in warps of `W` lanes (default 32). In each cycle every lane whose traversal
 //! has not ended makes exactly one transition of the core's own state machine (the code the CPU
-//! backend runs), and the simulator records how many lanes were active, what each transition was
-//! (internal node, leaf, backtracking step served by a stack pop, the register, the hash or a walk
-//! over links) and what it read, through [`CountingMemory`]. From that it reports SIMT efficiency,
-//! cycles per warp, memory traffic per table, distinct cache lines per warp-step, per-ray state
-//! and the stack traffic that the stackless methods avoid.
+//! backend runs) of any structure: the BVH2 methods, the kd methods but kd-packet, and the wide
+//! BVHs. The simulator records how many lanes were active, what each transition was (internal
+//! node, leaf, backtracking step served by a stack pop, the register, the hash, a walk over links
+//! or a restart) and what it read, through [`CountingMemory`], [`CountingKdMemory`] or
+//! [`CountingWideMemory`]. From that it reports SIMT efficiency, cycles per warp, memory traffic per
+//! table, distinct cache lines per warp-step and per ray, per-ray state, stack traffic and the
+//! chains of dependent reads. (The ray stream of Garanzha & Loop 2010 is not implemented in
+//! raytrail yet; it is to be added as a structure of its own.)
 //!
 //! - [`simulate`] runs one method over a batch of rays; [`report::tables`] prints a comparison.
 //! - [`Scenario`] builds the tree, the tables and a ray set for a scene.
 #![warn(missing_docs)]
 
+mod bvh2_lanes;
+mod kd_lanes;
 pub mod machine;
 pub mod memory;
 pub mod report;
 pub mod sim;
+mod stepper;
+mod wide_lanes;
 
-pub use memory::{CountingMemory, Table, Traffic};
+pub use memory::{CountingKdMemory, CountingMemory, CountingWideMemory, ReadTally, Table, Traffic};
 pub use sim::{simulate, CycleRecord, MethodReport, MethodRun, SimConfig, Transition};
 
 use raytrail_conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
@@ -87,11 +94,12 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    /// Builds the SAH tree of `scene`, prepares it for [`Method::BVH2`] and makes `kind` rays from a
+    /// Builds the SAH tree of `scene`, prepares it for every method ([`Method::ALL`]: the BVH2
+    /// layouts and hashes, the kd-tree, the wide trees) and makes `kind` rays from a
     /// `width` x `height` camera framing the scene (shadow and diffuse rays start at its hits).
     pub fn new(scene: Scene, kind: RayKind, width: u32, height: u32) -> Result<Scenario, String> {
         let bvh = SahBuilder::default().build(scene.triangles()).map_err(|e| e.to_string())?;
-        let prepared = PreparedScene::new(&scene, bvh, &Method::BVH2).map_err(|e| e.to_string())?;
+        let prepared = PreparedScene::new(&scene, bvh, &Method::ALL).map_err(|e| e.to_string())?;
         let camera = primary(&scene, width, height);
         let rays = match kind {
             RayKind::Primary => camera,

@@ -1,5 +1,5 @@
-//! One interface over the core's per-method state machines, so a lane can be stepped whatever
-//! its method.
+//! One interface over the core's per-method BVH2 state machines, so a BVH2 lane can be stepped
+//! whatever its method.
 
 use raytrail_core::bvh2::traverse::{
     ParentSiblingState, Paused, PerfectHashLookup, RegisterState, StackState, UncleHops,

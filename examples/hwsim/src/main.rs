@@ -1,6 +1,6 @@
 //! `raytrail-hwsim`: compares raytrail's traversal methods stepped in lockstep warps.
 
-use raytrail_core::method::{Bvh2Method, Method};
+use raytrail_core::method::{Bvh2Method, KdMethod, Method, Structure};
 use raytrail_hwsim::{report, simulate, RayKind, Scenario, SimConfig};
 use std::path::Path;
 
@@ -17,11 +17,31 @@ USAGE:
               camera resolution, default 256 x 192; shadow and diffuse rays start at its hits
   --warp      lanes per warp, default 32
   --rays      ray set, default primary (closest hit); shadow rays are any-hit queries
-  --methods   methods to compare, default all:
-              stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume
+  --methods   methods to compare (names, or the groups bvh2, kd, wide), default all of them:
+              bvh2: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume
+              kd: kd-stack, kd-restart, kd-push-down, kd-short-stack (kd-packet is not simulated:
+                  a packet of four rays is a lockstep unit of its own)
+              wide: bvh4, bvh8, bvh4-naive
   --timeline  also print the slowest warp's cycles for METHOD, one symbol per lane:
               . idle, i internal node, l leaf; backtracks: s stack pop, r register, h hash,
-              w walk over links (upper case: after a leaf)";
+              w walk over links, x restart (upper case: after a leaf)";
+
+/// The methods the simulator steps: every method but kd-packet.
+fn simulated() -> Vec<Method> {
+    Method::ALL.into_iter().filter(|&m| m != Method::Kd(KdMethod::Packet)).collect()
+}
+
+/// The methods of a name or a group name.
+fn methods_of(name: &str) -> Result<Vec<Method>, String> {
+    let group = |s: Structure| simulated().into_iter().filter(|m| m.structure() == s).collect();
+    match name {
+        "bvh2" => Ok(group(Structure::Bvh2)),
+        "kd" => Ok(group(Structure::Kd)),
+        "wide" => Ok(group(Structure::Wide)),
+        "all" => Ok(simulated()),
+        _ => Method::from_name(name).map(|m| vec![m]).ok_or_else(|| format!("unknown method '{name}'")),
+    }
+}
 
 struct Args {
     scene: String,
@@ -40,7 +60,7 @@ fn parse(args: &[String]) -> Result<Option<Args>, String> {
         height: 192,
         warp: 32,
         rays: RayKind::Primary,
-        methods: Method::BVH2.to_vec(),
+        methods: simulated(),
         timeline: None,
     };
     let mut it = args.iter();
@@ -57,7 +77,9 @@ fn parse(args: &[String]) -> Result<Option<Args>, String> {
             "--height" => a.height = number("--height")?,
             "--warp" => a.warp = number("--warp")? as usize,
             "--rays" => a.rays = RayKind::from_name(value).ok_or_else(|| format!("unknown ray set '{value}'"))?,
-            "--methods" => a.methods = value.split(',').map(method).collect::<Result<_, _>>()?,
+            "--methods" => {
+                a.methods = value.split(',').map(methods_of).collect::<Result<Vec<_>, _>>()?.concat();
+            }
             "--timeline" => a.timeline = Some(method(value)?),
             other => return Err(format!("unknown option '{other}'")),
         }
@@ -93,6 +115,7 @@ fn run(a: &Args) -> Result<(), String> {
         stats.depth,
         stats.key_width
     );
+    println!("{}", report::structures(&s.prepared));
     let query = a.rays.query();
     println!(
         "rays: {} {} ({} x {} camera), {} hit; watertight triangle test\n",
@@ -121,7 +144,7 @@ fn run(a: &Args) -> Result<(), String> {
     }
     if let Some((m, cycles)) = timeline {
         println!(
-            "\nSlowest warp, {m}, one row per cycle (. idle, i internal, l leaf;\nbacktracks s pop, r register, h hash, w walk, upper case after a leaf):"
+            "\nSlowest warp, {m}, one row per cycle (. idle, i internal, l leaf;\nbacktracks s pop, r register, h hash, w walk, x restart, upper case after a leaf):"
         );
         print!("{}", report::timeline(&cycles));
     }

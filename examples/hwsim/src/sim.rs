@@ -1,14 +1,13 @@
 //! The lockstep driver: rays in warps of `W` lanes, every unfinished lane making one transition
-//! per cycle, with what each transition was and what it read.
+//! per cycle, with what each transition was and what it read. The driver is the same for every
+//! structure; what a lane is and how it steps comes from a [`Stepper`](crate::stepper::Stepper).
 
-use crate::machine::{Machine, Resuming};
-use crate::memory::{CountingMemory, Traffic};
-use raytrail_core::bvh2::traverse::{
-    order_children, Descent, ParentSiblingState, PerfectHashLookup, RegisterState, StackState, TraceRoot, UncleHops,
-};
-use raytrail_core::bvh2::{BvhMemory, NodeRef};
-use raytrail_core::intersect::{RayContext, Watertight};
-use raytrail_core::key::{Key, KeyWidth};
+use crate::bvh2_lanes::simulate_bvh2;
+use crate::kd_lanes::simulate_kd;
+use crate::memory::Traffic;
+use crate::stepper::{Outcome, Stepper};
+use crate::wide_lanes::simulate_wide;
+use raytrail_core::bvh2::NodeRef;
 use raytrail_core::method::{Bvh2Method, Method, Query};
 use raytrail_core::observe::{Backtrack, Counters, Observer};
 use raytrail_core::prepared::PreparedScene;
@@ -55,7 +54,8 @@ pub enum Transition {
 
 impl Transition {
     /// One character for timelines: `.` idle, `i` internal, `l` leaf; backtracks: `s` stack pop,
-    /// `r` register, `h` hash, `w` walk over links (iterative), upper case after a leaf.
+    /// `r` register, `h` hash, `w` walk over links (iterative), `x` restart (kd), upper case after
+    /// a leaf.
     pub fn symbol(self) -> char {
         match self {
             Transition::Idle => '.',
@@ -67,7 +67,6 @@ impl Transition {
                     Backtrack::Register(_) => 'r',
                     Backtrack::Hash { .. } => 'h',
                     Backtrack::Iterative => 'w',
-                    // Restarts belong to the kd methods, which the simulator does not step.
                     Backtrack::Restart => 'x',
                 };
                 if leaf {
@@ -100,7 +99,8 @@ pub struct TransitionCounts {
     pub internal: u64,
     /// Steps that processed a leaf.
     pub leaf: u64,
-    /// Backtracking steps served by a stack pop.
+    /// Stack pops (one per backtracking step served by the stack; a wide traversal may pop and
+    /// drop several entries in one step).
     pub stack_pop: u64,
     /// ... by the most-recently-postponed-node register.
     pub register: u64,
@@ -108,6 +108,9 @@ pub struct TransitionCounts {
     pub hash: u64,
     /// ... by walking parent or uncle links.
     pub iterative: u64,
+    /// ... by descending again from the root or a pushed-down node (kd-restart, push-down, and
+    /// short-stack when its stack runs empty).
+    pub restart: u64,
 }
 
 /// What a method cost over a batch of rays in lockstep.
@@ -126,8 +129,14 @@ pub struct MethodReport {
     /// Cycles if each dependent memory round trip of a step took a cycle and a warp-step waited
     /// for its slowest lane: a step fetches its node or leaf (1), then each link read of a walk
     /// and each hash read (displacement, cell) depends on the one before. A rough latency model
-    /// that tells constant-time from iterative backtracking, which [`Self::cycles`] cannot.
+    /// that tells constant-time from iterative backtracking, which [`Self::cycles`] cannot. A kd
+    /// leaf's node, its primitive references and their triangles are three dependent reads.
     pub latency_cycles: u64,
+    /// Dependent reads summed over lane-steps (each step's chain, as for
+    /// [`Self::latency_cycles`]): the memory round trips a ray waits for one after another.
+    pub dependent_reads: u64,
+    /// The longest chain of dependent reads in any one step.
+    pub max_chain: u32,
     /// Lane-steps over all cycles (the sum of active lanes).
     pub lane_steps: u64,
     /// Cycles in which some lanes processed internal nodes and others leaves: the two are
@@ -135,11 +144,21 @@ pub struct MethodReport {
     pub divergent_cycles: u64,
     /// Transitions by kind.
     pub transitions: TransitionCounts,
-    /// Nodes postponed (both children hit): stack pushes for the stack methods, register
-    /// writes for the others.
+    /// Nodes postponed (more than one child entered): stack pushes for the stack methods,
+    /// register writes for the BVH2 register methods, hit children beyond the first for a wide
+    /// node, far children for the kd methods (pushed, or left to a restart).
     pub postponed: u64,
-    /// Most stack entries live at once in any ray (pushes minus pops; for stack-disjoint an upper
-    /// bound, since its hits drop entries without popping them). Zero for stackless methods.
+    /// Entries written to a stack (kd short-stack: including those later pushed off its bottom).
+    pub stack_pushes: u64,
+    /// Bytes of one stack entry: a 4-byte node reference (BVH2), reference and segment (kd, 12 B),
+    /// reference and entry distance (wide, 8 B); 0 for a method without a stack.
+    pub stack_entry_bytes: u64,
+    /// Steps where the kd lanes' model of the machine's segment and stack disagreed with the
+    /// machine (see `kd_lanes`); 0 unless the model is wrong, and always 0 for other structures.
+    pub stack_model_mismatches: u64,
+    /// Most stack entries live at once in any ray (pushes minus pops and drops; for
+    /// stack-disjoint an upper bound, since its hits drop entries without popping them). Zero for
+    /// stackless methods.
     pub peak_stack: u32,
     /// Pauses and resumes (hash-resume only).
     pub resumes: u64,
@@ -172,11 +191,16 @@ impl MethodReport {
         ratio(total, self.rays as u64)
     }
 
-    /// Bytes per ray moved to and from a stack (4-byte node references pushed and popped);
-    /// `None` for the stackless methods, which move none.
+    /// Bytes per ray moved to and from a stack (entries pushed and popped); `None` for the
+    /// stackless methods, which move none.
     pub fn stack_bytes_per_ray(&self) -> Option<f64> {
-        matches!(self.method, Method::Bvh2(Bvh2Method::Stack) | Method::Bvh2(Bvh2Method::StackDisjoint))
-            .then(|| self.per_ray(4 * (self.postponed + self.transitions.stack_pop)))
+        (self.stack_entry_bytes > 0)
+            .then(|| self.per_ray(self.stack_entry_bytes * (self.stack_pushes + self.transitions.stack_pop)))
+    }
+
+    /// Mean dependent reads per ray ([`Self::dependent_reads`]).
+    pub fn dependent_reads_per_ray(&self) -> f64 {
+        self.per_ray(self.dependent_reads)
     }
 }
 
@@ -203,8 +227,11 @@ pub struct MethodRun {
     pub timeline: Vec<CycleRecord>,
 }
 
-/// Simulates `method` over `rays` in lockstep warps, with the watertight triangle test and the key
-/// width the tree needs (`u32` or `u64`).
+/// Simulates `method` over `rays` in lockstep warps, with the watertight triangle test: any BVH2
+/// method (with the key width the tree needs), the kd methods but the packet one, and every wide
+/// method. kd-packet is a lockstep unit of its own (four rays sharing a node) and is an
+/// [`Error::Unsupported`], as is a method `prepared` lacks the tables of
+/// ([`Error::NotPrepared`]).
 pub fn simulate(
     prepared: &PreparedScene,
     method: impl Into<Method>,
@@ -212,37 +239,15 @@ pub fn simulate(
     cfg: &SimConfig,
 ) -> Result<MethodRun, Error> {
     let method = method.into();
-    match prepared.key_width() {
-        KeyWidth::W32 => simulate_keyed::<u32>(prepared, method, rays, cfg),
-        KeyWidth::W64 => simulate_keyed::<u64>(prepared, method, rays, cfg),
-    }
-}
-
-fn simulate_keyed<K: Key>(
-    prepared: &PreparedScene,
-    method: Method,
-    rays: &[Ray],
-    cfg: &SimConfig,
-) -> Result<MethodRun, Error> {
-    // The simulator steps BVH2 traversals; another structure's method is an `Unsupported` error.
-    let m = Bvh2Method::try_from(method)?;
-    let mem = CountingMemory::new(prepared.memory(m)?);
-    let root = prepared.root(m)?;
-    let stats = prepared.bvh.stats();
-    let sim = Sim { mem: &mem, root, cfg };
-    let mut run = match m {
-        Bvh2Method::Stack => sim.run::<StackState<false>>(rays),
-        Bvh2Method::StackDisjoint => sim.run::<StackState<true>>(rays),
-        Bvh2Method::ParentSibling => sim.run::<ParentSiblingState<K>>(rays),
-        Bvh2Method::Uncle => sim.run::<RegisterState<K, UncleHops, false>>(rays),
-        Bvh2Method::Hash => sim.run::<RegisterState<K, PerfectHashLookup, false>>(rays),
-        Bvh2Method::HashDisjoint => sim.run::<RegisterState<K, PerfectHashLookup, true>>(rays),
-        Bvh2Method::HashResume => sim.run::<Resuming<K>>(rays),
+    let mut run = match method {
+        Method::Bvh2(m) => simulate_bvh2(prepared, m, rays, cfg)?,
+        Method::Kd(m) => simulate_kd(prepared, m, rays, cfg)?,
+        Method::Wide(m) => simulate_wide(prepared, m, rays, cfg)?,
+        _ => return Err(Error::Unsupported { method: method.name(), by: "the lockstep simulator" }),
     };
     run.report.method = method;
-    run.report.traffic = mem.traffic();
-    run.report.state_bytes = method.state_bytes(stats.depth, K::WIDTH.bytes());
-    if !matches!(method, Method::Bvh2(Bvh2Method::Stack) | Method::Bvh2(Bvh2Method::StackDisjoint)) {
+    run.report.state_bytes = prepared.state_bytes(method);
+    if run.report.stack_entry_bytes == 0 {
         run.report.peak_stack = 0;
     }
     Ok(run)
@@ -250,18 +255,25 @@ fn simulate_keyed<K: Key>(
 
 /// What a lane's observer saw during one step, besides the running counters.
 #[derive(Clone, Copy, Debug, Default)]
-struct StepEvents {
-    node: Option<NodeRef>,
-    backtrack: Option<Backtrack>,
-    link_reads: u32,
+pub(crate) struct StepEvents {
+    /// The node or leaf the step processed.
+    pub node: Option<NodeRef>,
+    /// The backtracking step it ended with, if any.
+    pub backtrack: Option<Backtrack>,
+    /// Node records read to follow links.
+    pub link_reads: u32,
+    /// Stack entries popped (a wide traversal pops and drops entries that can no longer hold a
+    /// closer hit, several in one step).
+    pub pops: u32,
 }
 
 /// Per-lane observer: the core's counters, the current step's events and, optionally, the
 /// enumeration.
 #[derive(Debug, Default)]
-struct LaneObserver {
+pub(crate) struct LaneObserver {
     counters: Counters,
-    step: StepEvents,
+    /// This step's events.
+    pub step: StepEvents,
     nodes: Option<Vec<NodeRef>>,
 }
 
@@ -282,6 +294,7 @@ impl Observer for LaneObserver {
     fn backtrack(&mut self, levels: u32, via: Backtrack) {
         self.counters.backtrack(levels, via);
         self.step.backtrack = Some(via);
+        self.step.pops += (via == Backtrack::StackPop) as u32;
     }
     fn link_read(&mut self, node: NodeRef) {
         self.counters.link_read(node);
@@ -290,10 +303,10 @@ impl Observer for LaneObserver {
 }
 
 /// One ray in a warp.
-struct Lane<S> {
+struct Lane<L> {
     ray: usize,
-    state: S,
-    ctx: RayContext<Watertight>,
+    /// The structure's per-ray state; `None` for a ray that visits nothing.
+    state: Option<L>,
     q: QueryState,
     obs: LaneObserver,
     steps: u32,
@@ -301,160 +314,153 @@ struct Lane<S> {
     done: bool,
 }
 
-struct Sim<'a, M: BvhMemory> {
-    mem: &'a CountingMemory<M>,
-    root: TraceRoot,
-    cfg: &'a SimConfig,
+/// Runs `stepper` over `rays` in warps; the report's method and state bytes are the caller's to
+/// fill.
+pub(crate) fn drive<S: Stepper>(stepper: &S, rays: &[Ray], cfg: &SimConfig) -> MethodRun {
+    let warp = cfg.warp.max(1);
+    let mut out = MethodRun {
+        report: MethodReport {
+            method: Method::Bvh2(Bvh2Method::Stack),
+            rays: rays.len(),
+            warp,
+            warps: rays.len().div_ceil(warp),
+            cycles: 0,
+            latency_cycles: 0,
+            dependent_reads: 0,
+            max_chain: 0,
+            lane_steps: 0,
+            divergent_cycles: 0,
+            transitions: TransitionCounts::default(),
+            postponed: 0,
+            stack_pushes: 0,
+            stack_entry_bytes: stepper.stack_entry_bytes(),
+            stack_model_mismatches: 0,
+            peak_stack: 0,
+            resumes: 0,
+            traffic: Traffic::default(),
+            counters: Counters::default(),
+            state_bytes: 0,
+        },
+        hits: vec![Hit::MISS; rays.len()],
+        per_ray: vec![Counters::default(); rays.len()],
+        enumerations: if cfg.record_enumerations { vec![Vec::new(); rays.len()] } else { Vec::new() },
+        timeline: Vec::new(),
+    };
+    for (w, chunk) in rays.chunks(warp).enumerate() {
+        let mut timeline = cfg.record_timeline.then(Vec::new);
+        run_warp(stepper, cfg, w * warp, chunk, timeline.as_mut(), &mut out);
+        if let Some(t) = timeline.filter(|t| t.len() > out.timeline.len()) {
+            out.timeline = t;
+        }
+    }
+    out.report.counters.rays = rays.len() as u64;
+    out.report.traffic = stepper.traffic();
+    out
 }
 
-impl<M: BvhMemory> Sim<'_, M> {
-    fn run<S: Machine>(&self, rays: &[Ray]) -> MethodRun {
-        let warp = self.cfg.warp.max(1);
-        let mut out = MethodRun {
-            report: MethodReport {
-                method: Method::Bvh2(Bvh2Method::Stack),
-                rays: rays.len(),
-                warp,
-                warps: rays.len().div_ceil(warp),
-                cycles: 0,
-                latency_cycles: 0,
-                lane_steps: 0,
-                divergent_cycles: 0,
-                transitions: TransitionCounts::default(),
-                postponed: 0,
-                peak_stack: 0,
-                resumes: 0,
-                traffic: Traffic::default(),
-                counters: Counters::default(),
-                state_bytes: 0,
-            },
-            hits: vec![Hit::MISS; rays.len()],
-            per_ray: vec![Counters::default(); rays.len()],
-            enumerations: if self.cfg.record_enumerations { vec![Vec::new(); rays.len()] } else { Vec::new() },
-            timeline: Vec::new(),
-        };
-        for (w, chunk) in rays.chunks(warp).enumerate() {
-            let mut timeline = self.cfg.record_timeline.then(Vec::new);
-            self.run_warp::<S>(w * warp, chunk, timeline.as_mut(), &mut out);
-            if let Some(t) = timeline.filter(|t| t.len() > out.timeline.len()) {
-                out.timeline = t;
+fn run_warp<S: Stepper>(
+    stepper: &S,
+    cfg: &SimConfig,
+    first: usize,
+    rays: &[Ray],
+    mut timeline: Option<&mut Vec<CycleRecord>>,
+    out: &mut MethodRun,
+) {
+    let record_lanes = timeline.is_some();
+    let mut lanes: Vec<Lane<S::Lane>> = rays
+        .iter()
+        .enumerate()
+        .map(|(i, ray)| {
+            // As the CPU backend: a ray its structure turns away (not traceable, distances that
+            // overflow, missing the kd-tree's box) visits nothing.
+            let state = stepper.begin(ray);
+            Lane {
+                ray: first + i,
+                done: state.is_none(),
+                state,
+                q: QueryState::new(ray, cfg.query),
+                obs: LaneObserver { nodes: cfg.record_enumerations.then(Vec::new), ..LaneObserver::default() },
+                steps: 0,
+                live_stack: 0,
             }
-        }
-        out.report.counters.rays = rays.len() as u64;
-        out
-    }
-
-    fn run_warp<S: Machine>(
-        &self,
-        first: usize,
-        rays: &[Ray],
-        mut timeline: Option<&mut Vec<CycleRecord>>,
-        out: &mut MethodRun,
-    ) {
-        let record_lanes = timeline.is_some();
-        let mut lanes: Vec<Lane<S>> = rays
-            .iter()
-            .enumerate()
-            .map(|(i, ray)| {
-                let ctx = RayContext::new(ray, self.root.scene_scale);
-                Lane {
-                    ray: first + i,
-                    state: S::start(self.root.node),
-                    q: QueryState::new(ray, self.cfg.query),
-                    obs: LaneObserver { nodes: self.cfg.record_enumerations.then(Vec::new), ..LaneObserver::default() },
-                    steps: 0,
-                    live_stack: 0,
-                    // As `trace_ray`: a ray that cannot hit anything, or whose distances overflow,
-                    // visits nothing.
-                    done: !ray.is_traceable() || !ctx.is_reliable(),
-                    ctx,
-                }
-            })
-            .collect();
-        let r = &mut out.report;
-        loop {
-            let mut record = CycleRecord { active: 0, rounds: 0, lines: 0, lanes: Vec::new() };
-            let (mut internal, mut leaf) = (false, false);
-            for lane in &mut lanes {
-                if lane.done {
-                    if record_lanes {
-                        record.lanes.push(Transition::Idle);
-                    }
-                    continue;
-                }
-                // The culling distance before the step: an internal node's step uses it unchanged.
-                let limit = lane.q.limit();
-                lane.obs.step = StepEvents::default();
-                let hash_reads = self.mem.hash_reads();
-                let (step, resumed) = lane.state.step(self.mem, &lane.ctx, &mut lane.q, &mut lane.obs);
-                let ev = lane.obs.step;
-                // Lanes step one after another here, so the counter's growth is this lane's.
-                let rounds = 1 + ev.link_reads + (self.mem.hash_reads() - hash_reads) as u32;
-                record.rounds = record.rounds.max(rounds);
-                lane.steps += 1;
-                record.active += 1;
-                r.resumes += resumed as u64;
-                let is_leaf = ev.node.is_some_and(NodeRef::is_leaf);
-                if let Some(n) = ev.node.filter(|n| !n.is_leaf()) {
-                    internal = true;
-                    r.transitions.internal += 1;
-                    // Re-derive (without counting the read) whether both children were hit: the
-                    // stack methods push then, the others fill the register.
-                    let node = self.mem.inner().node(n.index());
-                    if let Descent::Both { .. } = order_children(&node, &lane.ctx, limit) {
-                        r.postponed += 1;
-                        lane.live_stack += 1;
-                        r.peak_stack = r.peak_stack.max(lane.live_stack);
-                    }
-                } else if is_leaf {
-                    leaf = true;
-                    r.transitions.leaf += 1;
-                }
-                let t = match ev.backtrack {
-                    Some(b) => {
-                        match b {
-                            Backtrack::StackPop => {
-                                r.transitions.stack_pop += 1;
-                                lane.live_stack = lane.live_stack.saturating_sub(1);
-                            }
-                            Backtrack::Register(_) => r.transitions.register += 1,
-                            Backtrack::Hash { .. } => r.transitions.hash += 1,
-                            Backtrack::Iterative => r.transitions.iterative += 1,
-                            // Only kd methods restart, and they are not simulated.
-                            Backtrack::Restart => r.transitions.iterative += 1,
-                        }
-                        Transition::Backtrack { leaf: is_leaf, via: b }
-                    }
-                    None if is_leaf => Transition::Leaf,
-                    None => Transition::Internal,
-                };
+        })
+        .collect();
+    let r = &mut out.report;
+    loop {
+        let mut record = CycleRecord { active: 0, rounds: 0, lines: 0, lanes: Vec::new() };
+        let (mut internal, mut leaf) = (false, false);
+        for lane in &mut lanes {
+            let Some(state) = lane.state.as_mut().filter(|_| !lane.done) else {
                 if record_lanes {
-                    record.lanes.push(t);
+                    record.lanes.push(Transition::Idle);
                 }
-                // The same step budget as `trace_ray`: binds only on damaged tables.
-                if step == Step::Done || lane.steps > self.root.max_steps {
-                    lane.done = true;
+                continue;
+            };
+            lane.obs.step = StepEvents::default();
+            let Outcome { step, resumed, postponed, pushed, dropped, rounds } =
+                stepper.step(state, &mut lane.q, &mut lane.obs);
+            let ev = lane.obs.step;
+            record.rounds = record.rounds.max(rounds);
+            r.dependent_reads += u64::from(rounds);
+            r.max_chain = r.max_chain.max(rounds);
+            lane.steps += 1;
+            record.active += 1;
+            r.resumes += resumed as u64;
+            r.postponed += u64::from(postponed);
+            r.stack_pushes += u64::from(pushed);
+            lane.live_stack = (lane.live_stack + pushed).saturating_sub(dropped);
+            r.peak_stack = r.peak_stack.max(lane.live_stack);
+            let is_leaf = ev.node.is_some_and(NodeRef::is_leaf);
+            if ev.node.is_some_and(|n| !n.is_leaf()) {
+                internal = true;
+                r.transitions.internal += 1;
+            } else if is_leaf {
+                leaf = true;
+                r.transitions.leaf += 1;
+            }
+            let t = match ev.backtrack {
+                Some(b) => {
+                    match b {
+                        Backtrack::StackPop => {
+                            r.transitions.stack_pop += u64::from(ev.pops);
+                            lane.live_stack = lane.live_stack.saturating_sub(ev.pops);
+                        }
+                        Backtrack::Register(_) => r.transitions.register += 1,
+                        Backtrack::Hash { .. } => r.transitions.hash += 1,
+                        Backtrack::Iterative => r.transitions.iterative += 1,
+                        Backtrack::Restart => r.transitions.restart += 1,
+                    }
+                    Transition::Backtrack { leaf: is_leaf, via: b }
                 }
+                None if is_leaf => Transition::Leaf,
+                None => Transition::Internal,
+            };
+            if record_lanes {
+                record.lanes.push(t);
             }
-            if record.active == 0 {
-                break;
-            }
-            record.lines = self.mem.end_cycle();
-            r.cycles += 1;
-            r.latency_cycles += u64::from(record.rounds);
-            r.lane_steps += u64::from(record.active);
-            r.divergent_cycles += (internal && leaf) as u64;
-            if let Some(t) = timeline.as_mut() {
-                t.push(record);
+            // The same step budget as the CPU backend's loops: binds only on damaged tables.
+            if step == Step::Done || lane.steps > stepper.max_steps() {
+                lane.done = true;
             }
         }
-        for lane in lanes {
-            out.hits[lane.ray] = lane.q.hit;
-            out.report.counters.add(&lane.obs.counters);
-            out.per_ray[lane.ray] = lane.obs.counters;
-            if let Some(n) = lane.obs.nodes {
-                out.enumerations[lane.ray] = n;
-            }
+        if record.active == 0 {
+            break;
+        }
+        record.lines = stepper.end_cycle();
+        r.cycles += 1;
+        r.latency_cycles += u64::from(record.rounds);
+        r.lane_steps += u64::from(record.active);
+        r.divergent_cycles += (internal && leaf) as u64;
+        if let Some(t) = timeline.as_mut() {
+            t.push(record);
+        }
+    }
+    for lane in lanes {
+        out.hits[lane.ray] = lane.q.hit;
+        out.report.counters.add(&lane.obs.counters);
+        out.per_ray[lane.ray] = lane.obs.counters;
+        if let Some(n) = lane.obs.nodes {
+            out.enumerations[lane.ray] = n;
         }
     }
 }

@@ -6,9 +6,8 @@ use raytrail_conformance::scenes::{degenerate_stack, sphereflake, SCENE_SEED};
 use raytrail_core::bvh2::traverse::trace_ray;
 use raytrail_core::intersect::Watertight;
 use raytrail_core::key::{Key, KeyWidth};
-use raytrail_core::method::{Bvh2Method, KdMethod, Query};
+use raytrail_core::method::{Bvh2Method, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
-use raytrail_core::Error;
 use raytrail_core::Ray;
 use raytrail_hwsim::{reference_hits, simulate, RayKind, Scenario, SimConfig};
 
@@ -113,11 +112,4 @@ fn stackless_methods_move_no_stack_bytes_and_hold_less_state() {
         // The timeline is the slowest warp: as many rows as that warp took cycles, one symbol a lane.
         assert!(!run.timeline.is_empty() && run.timeline.iter().all(|c| c.lanes.len() == 32), "{m}");
     }
-}
-
-#[test]
-fn a_kd_method_handed_to_the_bvh2_simulator_is_a_typed_error() {
-    let s = Scenario::new(sphereflake(1), RayKind::Primary, 4, 4).unwrap();
-    let got = simulate(&s.prepared, KdMethod::Stack, &s.rays, &SimConfig::new(Query::Closest));
-    assert_eq!(got.err(), Some(Error::Unsupported { method: "kd-stack", by: "a BVH2 traversal" }));
 }
