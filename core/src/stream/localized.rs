@@ -3,7 +3,7 @@
 //! ray does not enter over its current interval (up to its closest hit so far) is skipped, so
 //! leaves behind a hit cost one box test.
 
-use super::levels::LevelBvh;
+use super::levels::{LevelBvh, LevelNode};
 use crate::intersect::{NoPair, TriangleTest};
 use crate::method::Query;
 use crate::observe::Observer;
@@ -11,6 +11,48 @@ use crate::traverse::begin;
 use crate::wide::{ChildKernel, WideChild, WideNode};
 use crate::{Hit, Ray};
 use alloc::vec::Vec;
+
+/// The near side of a leaf's box along `axis` (and whether the rays run toward its negative end).
+fn near_side(n: &LevelNode, (a, negative): (usize, bool)) -> f32 {
+    if negative {
+        n.hi[a]
+    } else {
+        n.lo[a]
+    }
+}
+
+/// The order [`intersect_packet`] visits `leaves` in: by the near side of each leaf's box along
+/// the frustum's axis (`frustum_axis`: the axis and whether the rays run toward its negative end),
+/// ties by list position; the list order where the frustum has no axis.
+pub fn visiting_order(tree: &LevelBvh, leaves: &[u32], frustum_axis: Option<(usize, bool)>) -> Vec<u32> {
+    let near = |leaf: u32, axis| near_side(&tree.nodes()[leaf as usize], axis);
+    let mut order: Vec<u32> = leaves.to_vec();
+    if let Some(axis) = frustum_axis {
+        // Sorted by (near side, list position), packed in a `u64` with the float's bits made to
+        // order as integers: one sort of plain integers, no float comparisons.
+        let ordered_bits = |x: f32| {
+            let b = x.to_bits();
+            if b >> 31 == 1 {
+                !b
+            } else {
+                b | 1 << 31
+            }
+        };
+        let mut keyed: Vec<u64> = leaves
+            .iter()
+            .enumerate()
+            .map(|(i, &leaf)| {
+                let n = near(leaf, axis);
+                u64::from(ordered_bits(if axis.1 { -n } else { n })) << 32 | i as u64
+            })
+            .collect();
+        keyed.sort_unstable();
+        for (o, k) in order.iter_mut().zip(&keyed) {
+            *o = leaves[(k & 0xffff_ffff) as usize];
+        }
+    }
+    order
+}
 
 /// Traces `rays` (a packet's, in sorted order) against the leaves `leaves` (node indices, in
 /// order) into `hits` (one per ray). Leaves are tested with the wide traversal's
@@ -39,40 +81,8 @@ pub fn intersect_packet<T: TriangleTest, K: ChildKernel, O: Observer>(
     obs: &mut O,
 ) {
     let (nodes, mem) = (tree.nodes(), tree.leaf_memory());
-    // The near side of a leaf along the axis, and the order that makes it grow.
-    let near = |leaf: u32, (a, negative): (usize, bool)| {
-        let n = &nodes[leaf as usize];
-        if negative {
-            n.hi[a]
-        } else {
-            n.lo[a]
-        }
-    };
-    let mut order: Vec<u32> = leaves.to_vec();
-    if let Some(axis) = frustum_axis {
-        // Sorted by (near side, list position), packed in a `u64` with the float's bits made to
-        // order as integers: one sort of plain integers, no float comparisons.
-        let ordered_bits = |x: f32| {
-            let b = x.to_bits();
-            if b >> 31 == 1 {
-                !b
-            } else {
-                b | 1 << 31
-            }
-        };
-        let mut keyed: Vec<u64> = leaves
-            .iter()
-            .enumerate()
-            .map(|(i, &leaf)| {
-                let n = near(leaf, axis);
-                u64::from(ordered_bits(if axis.1 { -n } else { n })) << 32 | i as u64
-            })
-            .collect();
-        keyed.sort_unstable();
-        for (o, k) in order.iter_mut().zip(&keyed) {
-            *o = leaves[(k & 0xffff_ffff) as usize];
-        }
-    }
+    let order = visiting_order(tree, leaves, frustum_axis);
+    let near = |leaf: u32, axis| near_side(&nodes[leaf as usize], axis);
     let firsts: Vec<f32> =
         frustum_axis.map_or_else(Vec::new, |axis| order.chunks(8).map(|run| near(run[0], axis)).collect());
     let boxes: Vec<WideNode<8>> = order

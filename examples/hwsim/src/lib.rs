@@ -9,8 +9,9 @@
 //! or a restart) and what it read, through [`CountingMemory`], [`CountingKdMemory`] or
 //! [`CountingWideMemory`]. From that it reports SIMT efficiency, cycles per warp, memory traffic per
 //! table, distinct cache lines per warp-step and per ray, per-ray state, stack traffic and the
-//! chains of dependent reads. (The ray stream of Garanzha & Loop 2010 is not implemented in
-//! raytrail yet; it is to be added as a structure of its own.)
+//! chains of dependent reads. The ray stream of Garanzha & Loop 2010 is no state machine per ray: its
+//! intersection stage is modelled by [`stream_lanes`], warps of a packet's rays stepping through
+//! the packet's leaf list together.
 //!
 //! - [`simulate`] runs one method over a batch of rays; [`report::tables`] prints a comparison.
 //! - [`Scenario`] builds the tree, the tables and a ray set for a scene.
@@ -23,6 +24,7 @@ pub mod memory;
 pub mod report;
 pub mod sim;
 mod stepper;
+pub mod stream_lanes;
 mod wide_lanes;
 
 pub use memory::{CountingKdMemory, CountingMemory, CountingWideMemory, ReadTally, Table, Traffic};

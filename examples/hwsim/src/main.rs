@@ -1,6 +1,7 @@
 //! `raytrail-hwsim`: compares raytrail's traversal methods stepped in lockstep warps.
 
-use raytrail_core::method::{Bvh2Method, KdMethod, Method, Structure};
+use raytrail_core::method::{Bvh2Method, KdMethod, Method, StreamMethod, Structure};
+use raytrail_hwsim::stream_lanes::{self, simulate_stream, Packing};
 use raytrail_hwsim::{report, simulate, RayKind, Scenario, SimConfig};
 use std::path::Path;
 
@@ -22,11 +23,14 @@ USAGE:
               kd: kd-stack, kd-restart, kd-push-down, kd-short-stack (kd-packet is not simulated:
                   a packet of four rays is a lockstep unit of its own)
               wide: bvh4, bvh8, bvh4-naive
+              stream: Garanzha & Loop's sorted packets, modelled per warp of a packet's rays,
+                  sorted and (for comparison) packed in input order
   --timeline  also print the slowest warp's cycles for METHOD, one symbol per lane:
               . idle, i internal node, l leaf; backtracks: s stack pop, r register, h hash,
               w walk over links, x restart (upper case: after a leaf)";
 
-/// The methods the simulator steps: every method but kd-packet.
+/// The methods the simulator steps: every method but kd-packet (the stream method has a model
+/// of its own, `stream_lanes`).
 fn simulated() -> Vec<Method> {
     Method::ALL.into_iter().filter(|&m| m != Method::Kd(KdMethod::Packet)).collect()
 }
@@ -39,6 +43,7 @@ fn methods_of(name: &str) -> Result<Vec<Method>, String> {
         "kd" => Ok(group(Structure::Kd)),
         "wide" => Ok(group(Structure::Wide)),
         "all" => Ok(simulated()),
+        "stream" => Ok(vec![Method::Stream(StreamMethod::Frustum8)]),
         _ => Method::from_name(name).map(|m| vec![m]).ok_or_else(|| format!("unknown method '{name}'")),
     }
 }
@@ -127,7 +132,16 @@ fn run(a: &Args) -> Result<(), String> {
     );
     let mut reports = Vec::new();
     let mut timeline = None;
+    let mut stream_rows = Vec::new();
     for &m in &a.methods {
+        if m.stream().is_some() {
+            for packing in [Packing::Sorted, Packing::InputOrder] {
+                let (r, _) =
+                    simulate_stream(&s.prepared, &s.rays, query, a.warp, packing).map_err(|e| e.to_string())?;
+                stream_rows.push((packing, r));
+            }
+            continue;
+        }
         let cfg = SimConfig { warp: a.warp, record_timeline: a.timeline == Some(m), ..SimConfig::new(query) };
         let run = simulate(&s.prepared, m, &s.rays, &cfg).map_err(|e| e.to_string())?;
         if cfg.record_timeline {
@@ -136,6 +150,13 @@ fn run(a: &Args) -> Result<(), String> {
         reports.push(run.report);
     }
     print!("{}", report::tables(&reports));
+    if !stream_rows.is_empty() {
+        println!(
+            "\nstream (Garanzha & Loop 2010): each packet's rays in warps stepping through its leaf list together\n\
+             (a box test per leaf for every lane, the leaf's triangles for the lanes that enter it):"
+        );
+        print!("{}", stream_lanes::table(&stream_rows));
+    }
     if reports.iter().any(|r| r.method == Method::Bvh2(Bvh2Method::HashResume)) {
         println!(
             "  hash-resume runs in lockstep too: a lane pauses after each leaf with a hit and resumes from key and\n  \
