@@ -10,6 +10,7 @@ use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
 use crate::traverse::{for_each_ray, QueryState, Step};
 use crate::{Hit, Ray};
+use core::mem::MaybeUninit;
 
 /// Stack entries: enough for `W - 1` postponed children on each of 63 levels, `W` up to 8.
 pub const WIDE_STACK: usize = 448;
@@ -31,17 +32,21 @@ pub struct WideRoot {
 
 /// One ray's traversal state: the child being visited, and the postponed children with the entry
 /// distances they were found at.
+///
+/// The stack's storage is left uninitialized: only the entries below `len` are ever read, and each
+/// was written by a push first. Filling all 448 entries on every `new` (5 KiB) tripled the cost of
+/// a ray traced on its own on a Cortex-M4F (21.6k instructions against 7.7k in a batch).
 #[derive(Clone, Debug)]
 pub struct WideState<const W: usize> {
     current: Option<WideChild>,
     len: usize,
-    stack: [(WideChild, f32); WIDE_STACK],
+    stack: [MaybeUninit<(WideChild, f32)>; WIDE_STACK],
 }
 
 impl<const W: usize> WideState<W> {
     /// Starts at `root`.
     pub fn new(root: WideChild) -> Self {
-        Self { current: Some(root), len: 0, stack: [(root, 0.0); WIDE_STACK] }
+        Self { current: Some(root), len: 0, stack: [const { MaybeUninit::uninit() }; WIDE_STACK] }
     }
 
     /// Starts over at `root` for another ray, keeping the stack's storage.
@@ -89,7 +94,7 @@ impl<const W: usize> WideState<W> {
                     let slot = order[k] as usize;
                     if self.len < WIDE_STACK {
                         if let Some(c) = node.child_ref(slot) {
-                            self.stack[self.len] = (c, hits.t_enter[slot % W]);
+                            self.stack[self.len] = MaybeUninit::new((c, hits.t_enter[slot % W]));
                             self.len += 1;
                         }
                     }
@@ -120,7 +125,9 @@ impl<const W: usize> WideState<W> {
     ) -> Step {
         while self.len > 0 {
             self.len -= 1;
-            let (child, t_enter) = self.stack[self.len];
+            // SAFETY: entries below `len` were written by a push before `len` passed them (`len`
+            // only grows by a push that writes the entry it passes), and `len` was above this one.
+            let (child, t_enter) = unsafe { self.stack[self.len].assume_init() };
             obs.backtrack(0, Backtrack::StackPop);
             if t_enter > q.limit() + ctx.t_slack {
                 continue;
