@@ -23,6 +23,7 @@ mod probe;
 mod record;
 mod scene;
 mod spirv;
+mod stream;
 
 pub use backend::WgpuBackend;
 pub use device::{KernelForm, KERNEL_FORM};
