@@ -88,9 +88,9 @@ pub fn traverse<P: Parallel, F: FrustumTest>(exec: &P, nodes: &[LevelNode], frus
         let mut next = PairQueue { frustum: vec![0; total as usize], node: vec![0; total as usize] };
         for (i, (count, children)) in expanded.iter().enumerate() {
             let at = offsets[i] as usize;
-            for k in 0..*count as usize {
+            for (k, &child) in children.iter().take(*count as usize).enumerate() {
                 next.frustum[at + k] = queue.frustum[i];
-                next.node[at + k] = children[k];
+                next.node[at + k] = child;
             }
         }
         queue = next;
