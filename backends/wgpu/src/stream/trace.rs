@@ -57,12 +57,12 @@ fn start<'a>(
         }
         Ok(bytes.max(16))
     };
+    check("the rays", ray_bytes.len() as u64)?;
     let rays_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("stream rays"),
         contents: ray_bytes,
         usage: wgpu::BufferUsages::STORAGE,
     });
-    check("the rays", ray_bytes.len() as u64)?;
     let rw = |label: &str, bytes: u64| -> Result<wgpu::Buffer, Error> {
         Ok(device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
@@ -72,7 +72,7 @@ fn start<'a>(
         }))
     };
     let hits = rw("the hits", 16 * rays.len() as u64)?;
-    let records = rw("the records", 4 * (rays.len() * record_stride) as u64)?;
+    let records = rw("the records", 4 * rays.len() as u64 * record_stride as u64)?;
     let fixed = Fixed { params, rays: rays_buffer, hits, empty: &scene.empty, levels: &levels.buffer, records };
     Ok((Run::new(gpu, kernels, fixed)?, s))
 }
@@ -134,7 +134,9 @@ fn trace_checked(
     run.dispatch(StreamKernel::Intersect(variant), n, stage, &[&p.order, &p.bounds, &l.ranges, &l.node])?;
     let (hit_buffer, record_buffer) = run.outputs();
     let (hit_buffer, record_buffer) = (hit_buffer.clone(), record_buffer.clone());
-    let back = run.read(&[(&hit_buffer, 0, 4 * n), (&record_buffer, 0, n * stride as u32)])?;
+    // Both fit 32-bit word counts: `start` bounded their bytes by a binding's size.
+    let words = |per_ray: usize| u32::try_from(rays.len() * per_ray).map_err(|_| device_error("too many rays"));
+    let back = run.read(&[(&hit_buffer, 0, words(4)?), (&record_buffer, 0, words(stride)?)])?;
     run.next_stage(3)?;
     hits.copy_from_slice(bytemuck::cast_slice(&back[0]));
     let (seconds, _) = run.seconds();
