@@ -74,13 +74,16 @@ impl WgpuBackend {
         crate::probe::probe(&self.gpu, samples)
     }
 
-    /// Compiles every kernel the scene can use (both queries, no recording), so that a first
-    /// timed call does not pay for compilation.
+    /// Compiles the kernels a trace of `method` with `options` runs (for the stream method, all of
+    /// its stages), so that a first timed call does not pay for compilation.
     pub fn warm_up(&self, scene: &WgpuScene, method: Method, options: &TraceOptions) -> Result<(), Error> {
+        if let Method::Stream(m) = method {
+            return self.stream_kernels()?.warm_up(&self.gpu, m, options);
+        }
         self.pipelines.get(&self.gpu, &variant(scene, method, options)).map(|_| ())
     }
 
-    /// The stream method's kernels, or [`Error::Unsupported`] naming why the adapter lacks them.
+    /// The stream method's kernels, or [`Error::Device`] naming why the adapter cannot run them.
     fn stream_kernels(&self) -> Result<&StreamKernels, Error> {
         self.stream.as_ref().map_err(|why| device_error(format!("the stream method is unavailable: {why}")))
     }

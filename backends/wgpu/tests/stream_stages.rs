@@ -177,6 +177,7 @@ fn traces_report_the_cores_figures() {
     for (set, rays) in rays_for(&prepared, &named) {
         for query in [Query::Closest, Query::Any] {
             let opts = TraceOptions::new(STREAM).query(query).record(Record::Counters);
+            backend.warm_up(&scene, STREAM, &opts).expect("every stream kernel compiles");
             let (mut want, mut got) = (vec![Hit::MISS; rays.len()], vec![Hit::MISS; rays.len()]);
             let expected = serial.trace(&serial_scene, &rays, &opts, &mut want).expect("serial trace");
             let report = backend.trace(&scene, &rays, &opts, &mut got).expect("device trace");

@@ -5,9 +5,10 @@
 //! triangle test, query, recording and wide.wgsl's leaf test, as the wide methods' kernels do.
 
 use crate::compose::Variant;
+use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Method, StreamMethod};
 use raytrail_core::stream::frustum::{MARGIN, NO_AXIS};
-use raytrail_core::trace::Record;
+use raytrail_core::trace::{Record, TraceOptions};
 use raytrail_core::Error;
 
 type Part = (&'static str, &'static str);
@@ -47,7 +48,6 @@ pub(crate) enum StreamKernel {
 
 impl StreamKernel {
     /// Every kernel but the intersection (which [`crate::compose::all_variants`] covers).
-    #[cfg(test)]
     pub(crate) const STAGES: [StreamKernel; 20] = [
         StreamKernel::Keys,
         StreamKernel::Heads,
@@ -70,6 +70,19 @@ impl StreamKernel {
         StreamKernel::PairScatter,
         StreamKernel::Ranges,
     ];
+
+    /// The intersection kernel a trace with `options` runs: one per triangle test, query and
+    /// whether counters are kept (the key width does not matter to it).
+    pub(crate) fn intersect(method: StreamMethod, options: &TraceOptions) -> StreamKernel {
+        let record = if options.record == Record::Nothing { Record::Nothing } else { Record::Counters };
+        StreamKernel::Intersect(Variant {
+            method: method.into(),
+            keys: KeyWidth::W32,
+            triangle: options.triangle_test,
+            query: options.query,
+            record,
+        })
+    }
 
     /// The kernel's name, for labels.
     pub(crate) fn label(&self) -> String {

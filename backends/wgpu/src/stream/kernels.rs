@@ -3,6 +3,8 @@
 use super::compose::StreamKernel;
 use crate::device::{device_error, Gpu};
 use crate::pipelines::buffer_layout;
+use raytrail_core::method::StreamMethod;
+use raytrail_core::trace::TraceOptions;
 use raytrail_core::Error;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
@@ -37,6 +39,14 @@ impl StreamKernels {
         kinds.extend(std::iter::repeat_n(write, STAGE_ARRAYS));
         let (bind_layout, layout) = buffer_layout(gpu, "raytrail stream", &kinds);
         Ok(StreamKernels { bind_layout, layout, compiled: Mutex::new(HashMap::new()) })
+    }
+
+    /// Compiles every stage kernel and the intersection kernel of a trace with `options`.
+    pub fn warm_up(&self, gpu: &Gpu, method: StreamMethod, options: &TraceOptions) -> Result<(), Error> {
+        for k in StreamKernel::STAGES.into_iter().chain([StreamKernel::intersect(method, options)]) {
+            self.get(gpu, k)?;
+        }
+        Ok(())
     }
 
     /// The pipeline of `k`, compiled now if it was not yet.

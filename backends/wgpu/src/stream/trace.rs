@@ -4,12 +4,10 @@ use super::compose::StreamKernel;
 use super::kernels::StreamKernels;
 use super::plan::{plan, read_plan, GpuPlan};
 use super::run::{Fixed, Run, StageUniform};
-use crate::compose::Variant;
 use crate::device::{device_error, Gpu};
 use crate::params::Params;
 use crate::record;
 use crate::scene::WgpuScene;
-use raytrail_core::key::KeyWidth;
 use raytrail_core::method::StreamMethod;
 use raytrail_core::observe::Counters;
 use raytrail_core::stream::pipeline::{StageSeconds, StreamPlan};
@@ -120,18 +118,9 @@ fn trace_checked(
     let n = rays.len() as u32;
     let p = plan(&mut run, &s, n, &options.stream)?;
     run.next_stage(3)?;
-    // One intersection kernel per triangle test, query and whether counters are kept.
-    let record = if options.record == Record::Nothing { Record::Nothing } else { Record::Counters };
-    let variant = Variant {
-        method: method.into(),
-        keys: KeyWidth::W32,
-        triangle: options.triangle_test,
-        query: options.query,
-        record,
-    };
     let l = &p.lists;
     let stage = StageUniform::items(n).a(p.packets);
-    run.dispatch(StreamKernel::Intersect(variant), n, stage, &[&p.order, &p.bounds, &l.ranges, &l.node])?;
+    run.dispatch(StreamKernel::intersect(method, options), n, stage, &[&p.order, &p.bounds, &l.ranges, &l.node])?;
     let (hit_buffer, record_buffer) = run.outputs();
     let (hit_buffer, record_buffer) = (hit_buffer.clone(), record_buffer.clone());
     // Both fit 32-bit word counts: `start` bounded their bytes by a binding's size.
