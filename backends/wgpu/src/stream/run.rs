@@ -68,7 +68,7 @@ struct Timer {
 
 /// A trace in progress.
 pub(crate) struct Run<'a> {
-    pub gpu: &'a Gpu,
+    gpu: &'a Gpu,
     kernels: &'a StreamKernels,
     fixed: Fixed<'a>,
     /// Bound where a kernel has fewer arrays than the layout.
