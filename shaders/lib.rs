@@ -82,6 +82,86 @@ pub const QUERY: Source = Source { name: "query.wgsl", text: include_str!("query
 /// `record.wgsl`.
 pub const RECORD: Source = Source { name: "record.wgsl", text: include_str!("record.wgsl") };
 
+/// `stream_common.wgsl`.
+pub const STREAM_COMMON: Source = Source { name: "stream_common.wgsl", text: include_str!("stream_common.wgsl") };
+
+/// `stream_compact.wgsl`.
+pub const STREAM_COMPACT: Source = Source { name: "stream_compact.wgsl", text: include_str!("stream_compact.wgsl") };
+
+/// `stream_cull.wgsl`.
+pub const STREAM_CULL: Source = Source { name: "stream_cull.wgsl", text: include_str!("stream_cull.wgsl") };
+
+/// `stream_expand.wgsl`.
+pub const STREAM_EXPAND: Source = Source { name: "stream_expand.wgsl", text: include_str!("stream_expand.wgsl") };
+
+/// `stream_fill.wgsl`.
+pub const STREAM_FILL: Source = Source { name: "stream_fill.wgsl", text: include_str!("stream_fill.wgsl") };
+
+/// `stream_frustum.wgsl`.
+pub const STREAM_FRUSTUM: Source = Source { name: "stream_frustum.wgsl", text: include_str!("stream_frustum.wgsl") };
+
+/// `stream_gather.wgsl`.
+pub const STREAM_GATHER: Source = Source { name: "stream_gather.wgsl", text: include_str!("stream_gather.wgsl") };
+
+/// `stream_heads.wgsl`.
+pub const STREAM_HEADS: Source = Source { name: "stream_heads.wgsl", text: include_str!("stream_heads.wgsl") };
+
+/// `stream_intersect.wgsl`.
+pub const STREAM_INTERSECT: Source =
+    Source { name: "stream_intersect.wgsl", text: include_str!("stream_intersect.wgsl") };
+
+/// `stream_keys.wgsl`.
+pub const STREAM_KEYS: Source = Source { name: "stream_keys.wgsl", text: include_str!("stream_keys.wgsl") };
+
+/// `stream_levels.wgsl`.
+pub const STREAM_LEVELS: Source = Source { name: "stream_levels.wgsl", text: include_str!("stream_levels.wgsl") };
+
+/// `stream_packet_counts.wgsl`.
+pub const STREAM_PACKET_COUNTS: Source =
+    Source { name: "stream_packet_counts.wgsl", text: include_str!("stream_packet_counts.wgsl") };
+
+/// `stream_pair_scatter.wgsl`.
+pub const STREAM_PAIR_SCATTER: Source =
+    Source { name: "stream_pair_scatter.wgsl", text: include_str!("stream_pair_scatter.wgsl") };
+
+/// `stream_radix_count.wgsl`.
+pub const STREAM_RADIX_COUNT: Source =
+    Source { name: "stream_radix_count.wgsl", text: include_str!("stream_radix_count.wgsl") };
+
+/// `stream_radix_scatter.wgsl`.
+pub const STREAM_RADIX_SCATTER: Source =
+    Source { name: "stream_radix_scatter.wgsl", text: include_str!("stream_radix_scatter.wgsl") };
+
+/// `stream_ranges.wgsl`.
+pub const STREAM_RANGES: Source = Source { name: "stream_ranges.wgsl", text: include_str!("stream_ranges.wgsl") };
+
+/// `stream_roots_flag.wgsl`.
+pub const STREAM_ROOTS_FLAG: Source =
+    Source { name: "stream_roots_flag.wgsl", text: include_str!("stream_roots_flag.wgsl") };
+
+/// `stream_roots_scatter.wgsl`.
+pub const STREAM_ROOTS_SCATTER: Source =
+    Source { name: "stream_roots_scatter.wgsl", text: include_str!("stream_roots_scatter.wgsl") };
+
+/// `stream_scan.wgsl`.
+pub const STREAM_SCAN: Source = Source { name: "stream_scan.wgsl", text: include_str!("stream_scan.wgsl") };
+
+/// `stream_scan_add.wgsl`.
+pub const STREAM_SCAN_ADD: Source = Source { name: "stream_scan_add.wgsl", text: include_str!("stream_scan_add.wgsl") };
+
+/// `stream_segscan.wgsl`.
+pub const STREAM_SEGSCAN: Source = Source { name: "stream_segscan.wgsl", text: include_str!("stream_segscan.wgsl") };
+
+/// `stream_segscan_add.wgsl`.
+pub const STREAM_SEGSCAN_ADD: Source =
+    Source { name: "stream_segscan_add.wgsl", text: include_str!("stream_segscan_add.wgsl") };
+
+/// `stream_sizes.wgsl`.
+pub const STREAM_SIZES: Source = Source { name: "stream_sizes.wgsl", text: include_str!("stream_sizes.wgsl") };
+
+/// `stream_skeleton.wgsl`.
+pub const STREAM_SKELETON: Source = Source { name: "stream_skeleton.wgsl", text: include_str!("stream_skeleton.wgsl") };
+
 /// `triangle_moller_trumbore.wgsl`.
 pub const TRIANGLE_MOLLER_TRUMBORE: Source =
     Source { name: "triangle_moller_trumbore.wgsl", text: include_str!("triangle_moller_trumbore.wgsl") };
@@ -89,6 +169,7 @@ pub const TRIANGLE_MOLLER_TRUMBORE: Source =
 /// `triangle_watertight.wgsl`.
 pub const TRIANGLE_WATERTIGHT: Source =
     Source { name: "triangle_watertight.wgsl", text: include_str!("triangle_watertight.wgsl") };
+
 /// `wide.wgsl`.
 pub const WIDE: Source = Source { name: "wide.wgsl", text: include_str!("wide.wgsl") };
 
@@ -116,8 +197,33 @@ pub const ALL: &[Source] = &[
     PROBE,
     QUERY,
     RECORD,
+    STREAM_COMMON,
+    STREAM_COMPACT,
+    STREAM_CULL,
+    STREAM_EXPAND,
+    STREAM_FILL,
+    STREAM_FRUSTUM,
+    STREAM_GATHER,
+    STREAM_HEADS,
+    STREAM_INTERSECT,
+    STREAM_KEYS,
+    STREAM_LEVELS,
+    STREAM_PACKET_COUNTS,
+    STREAM_PAIR_SCATTER,
+    STREAM_RADIX_COUNT,
+    STREAM_RADIX_SCATTER,
+    STREAM_RANGES,
+    STREAM_ROOTS_FLAG,
+    STREAM_ROOTS_SCATTER,
+    STREAM_SCAN,
+    STREAM_SCAN_ADD,
+    STREAM_SEGSCAN,
+    STREAM_SEGSCAN_ADD,
+    STREAM_SIZES,
+    STREAM_SKELETON,
     TRIANGLE_MOLLER_TRUMBORE,
     TRIANGLE_WATERTIGHT,
+    WIDE,
 ];
 
 /// The file of `name` (for example `"box.wgsl"`), if there is one.

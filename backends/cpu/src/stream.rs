@@ -30,8 +30,7 @@ impl Parallel for Rayon {
     /// A parallel sort of (key, chunk index) pairs packed in a `u64`: the chunks come in base
     /// order, so this is the radix sort's order (by key, then base), on both cores.
     fn sort_chunks(&self, chunks: &mut Chunks) {
-        let mut packed: Vec<u64> =
-            chunks.key.iter().enumerate().map(|(i, &k)| u64::from(k) << 32 | i as u64).collect();
+        let mut packed: Vec<u64> = chunks.key.iter().enumerate().map(|(i, &k)| u64::from(k) << 32 | i as u64).collect();
         packed.par_sort_unstable();
         let (base, size) = (chunks.base.clone(), chunks.size.clone());
         for (at, &p) in packed.iter().enumerate() {

@@ -7,12 +7,14 @@ use crate::params::Params;
 use crate::pipelines::Pipelines;
 use crate::record;
 use crate::scene::WgpuScene;
+use crate::stream::kernels::StreamKernels;
 use raytrail_core::bvh2::NodeRef;
 use raytrail_core::kd::traverse::packets::{packet_slots, PADDING};
 use raytrail_core::kd::traverse::PACKET_WIDTH;
 use raytrail_core::method::{KdMethod, Method};
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
+use raytrail_core::stream::{StreamParams, StreamPlan};
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
 use raytrail_core::wide::WideChild;
 use raytrail_core::{Error, Hit, Ray};
@@ -36,6 +38,8 @@ const PACKET: usize = PACKET_WIDTH;
 pub struct WgpuBackend {
     gpu: Gpu,
     pipelines: Pipelines,
+    /// The stream method's kernels, or why the adapter cannot run them.
+    stream: Result<StreamKernels, String>,
 }
 
 impl WgpuBackend {
@@ -49,7 +53,8 @@ impl WgpuBackend {
     pub fn with_kernel_form(form: KernelForm) -> Result<WgpuBackend, Error> {
         let gpu = Gpu::open(form)?;
         let pipelines = Pipelines::new(&gpu);
-        Ok(WgpuBackend { gpu, pipelines })
+        let stream = StreamKernels::new(&gpu).map_err(|e| e.to_string());
+        Ok(WgpuBackend { gpu, pipelines, stream })
     }
 
     /// The adapter, for reports.
@@ -69,10 +74,25 @@ impl WgpuBackend {
         crate::probe::probe(&self.gpu, samples)
     }
 
-    /// Compiles every kernel the scene can use (both queries, no recording), so that a first
-    /// timed call does not pay for compilation.
+    /// Compiles the kernels a trace of `method` with `options` runs (for the stream method, all of
+    /// its stages), so that a first timed call does not pay for compilation.
     pub fn warm_up(&self, scene: &WgpuScene, method: Method, options: &TraceOptions) -> Result<(), Error> {
+        if let Method::Stream(m) = method {
+            return self.stream_kernels()?.warm_up(&self.gpu, m, options);
+        }
         self.pipelines.get(&self.gpu, &variant(scene, method, options)).map(|_| ())
+    }
+
+    /// The stream method's kernels, or [`Error::Device`] naming why the adapter cannot run them.
+    fn stream_kernels(&self) -> Result<&StreamKernels, Error> {
+        self.stream.as_ref().map_err(|why| device_error(format!("the stream method is unavailable: {why}")))
+    }
+
+    /// The stream method's stages one to three on the device (keys, sorted order, packet bounds,
+    /// frustums, the traversal's final queue, ranges and figures), read back in the core's form:
+    /// `raytrail_core::stream::pipeline::plan` gives the same arrays, bit for bit.
+    pub fn stream_plan(&self, scene: &WgpuScene, rays: &[Ray], params: &StreamParams) -> Result<StreamPlan, Error> {
+        crate::stream::plan_only(&self.gpu, self.stream_kernels()?, scene, rays, params)
     }
 
     /// Rays per batch: within the adapter's binding and dispatch limits and the byte budget.
@@ -227,9 +247,14 @@ impl Trace for WgpuBackend {
         "wgpu"
     }
 
-    /// Every BVH2, kd and wide-BVH method.
+    /// Every BVH2, kd, wide-BVH and stream method (the stream method where the adapter allows its
+    /// kernels' bindings).
     fn supports(&self, method: Method) -> bool {
-        matches!(method, Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_))
+        match method {
+            Method::Bvh2(_) | Method::Kd(_) | Method::Wide(_) => true,
+            Method::Stream(_) => self.stream.is_ok(),
+            _ => false,
+        }
     }
 
     fn prepare(&self, scene: Arc<PreparedScene>) -> Result<WgpuScene, Error> {
@@ -246,6 +271,11 @@ impl Trace for WgpuBackend {
         check_buffers(rays, hits)?;
         if !self.supports(options.method) {
             return Err(Error::Unsupported { method: options.method.name(), by: "the wgpu backend" });
+        }
+        if let Method::Stream(m) = options.method {
+            // The batch as a whole: packets are made from all of its rays.
+            scene.prepared.check_prepared(options.method)?;
+            return crate::stream::trace(&self.gpu, self.stream_kernels()?, scene, m, rays, options, hits);
         }
         let start = Instant::now();
         let Traced { hits: out, records, stride, gpu_seconds } =

@@ -100,6 +100,8 @@ impl Variant {
             }
             Method::Kd(KdMethod::Packet) => &[KD_COMMON, KD_PACKET],
             Method::Wide(_) => &[WIDE],
+            // Its stages are kernels of their own (crate::stream); this is the one that traces.
+            Method::Stream(_) => return crate::stream::compose::StreamKernel::Intersect(*self).parts(),
             other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
         };
         parts.extend_from_slice(method);
@@ -112,6 +114,9 @@ impl Variant {
 
     /// The full WGSL source: the generated constants, then the parts.
     pub fn source(&self) -> Result<String, Error> {
+        if let Method::Stream(_) = self.method {
+            return crate::stream::compose::StreamKernel::Intersect(*self).source();
+        }
         let mut s = constants_header(self.method);
         for (name, text) in self.parts()? {
             s.push_str(&format!("\n// ---- shaders/{name} ----\n"));
@@ -139,8 +144,12 @@ impl Variant {
 
 /// Constants the shaders must share with the core bit for bit, written from the core's own
 /// values rather than retyped as WGSL literals (which a compiler would round its own way).
-fn constants_header(method: Method) -> String {
-    let wide_width = method.wide().map_or(4, |m| m.width());
+pub(crate) fn constants_header(method: Method) -> String {
+    // The stream method's leaves are those of the 8-wide tree.
+    let wide_width = match method {
+        Method::Stream(_) => 8,
+        _ => method.wide().map_or(4, |m| m.width()),
+    };
     let kd_mode = match method {
         Method::Kd(KdMethod::Restart) => 0,
         Method::Kd(KdMethod::PushDown) => 1,

@@ -1,7 +1,8 @@
 //! raytrail-wgpu: the wgpu backend of raytrail.
 //!
 //! [`WgpuBackend`] implements the backend-agnostic [`Trace`](raytrail_core::trace::Trace) trait
-//! with WGSL compute kernels (one invocation per ray; one per packet of four rays for kd-packet),
+//! with WGSL compute kernels (one invocation per ray; one per packet of four rays for kd-packet; a
+//! pipeline of kernels for the stream method, whose stages are all on the device),
 //! composed from the files in `shaders/` and specialized per method, key width, triangle test,
 //! query and recording ([`compose`]). Each kernel mirrors its core state machine transition for
 //! transition, and its arithmetic is written to come out bit for bit as on the CPU whatever the
@@ -23,6 +24,7 @@ mod probe;
 mod record;
 mod scene;
 mod spirv;
+mod stream;
 
 pub use backend::WgpuBackend;
 pub use device::{KernelForm, KERNEL_FORM};

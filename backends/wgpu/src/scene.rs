@@ -44,6 +44,9 @@ pub struct WgpuScene {
     pub(crate) wide4: Option<KdBuffer>,
     pub(crate) wide8: Option<KdBuffer>,
     pub(crate) wide4_naive: Option<KdBuffer>,
+    /// The stream method's level-order tree, laid out as the wide trees are: nodes (eight words
+    /// each, `LevelNode`), primitive ids, triangles.
+    pub(crate) levels: Option<KdBuffer>,
     /// A small buffer bound where a kernel's unused bindings would be.
     pub(crate) empty: wgpu::Buffer,
 }
@@ -138,8 +141,33 @@ impl WgpuScene {
         let wide4 = p.wide4.as_ref().map(|t| wide(gpu, "4-wide BVH", t)).transpose()?;
         let wide8 = p.wide8.as_ref().map(|t| wide(gpu, "8-wide BVH", t)).transpose()?;
         let wide4_naive = p.wide4_naive.as_ref().map(|t| wide(gpu, "naive 4-wide BVH", t)).transpose()?;
+        let levels = p
+            .levels
+            .as_ref()
+            .map(|t| {
+                nodes_prims_triangles(
+                    gpu,
+                    "level-order tree",
+                    bytemuck::cast_slice(t.nodes()),
+                    t.prims(),
+                    t.triangles(),
+                )
+            })
+            .transpose()?;
         let empty = storage(gpu, "empty", &[])?;
-        Ok(WgpuScene { prepared, uncles, parents, hash: hash_tables, full_hash, kd, wide4, wide8, wide4_naive, empty })
+        Ok(WgpuScene {
+            prepared,
+            uncles,
+            parents,
+            hash: hash_tables,
+            full_hash,
+            kd,
+            wide4,
+            wide8,
+            wide4_naive,
+            levels,
+            empty,
+        })
     }
 
     /// The layout buffer `method` reads.
@@ -184,5 +212,6 @@ impl WgpuScene {
             + k(&self.wide4)
             + k(&self.wide8)
             + k(&self.wide4_naive)
+            + k(&self.levels)
     }
 }
