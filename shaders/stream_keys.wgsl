@@ -2,7 +2,7 @@
 //
 // S.n: rays. S.v0: the origin grid's lower corner (xyz, f32 bits) and 1 / cell size (w);
 // S.v1: origin cells per axis (xyz) and the origin Morton code's bits (w); S.v2: direction cells
-// per face side, bits of a face position, whether the cell pair is the key as it is (1) or mixed.
+// per face side, bits of a face position, the origin code's bits dropped to fit 32 bits.
 // Binding 8: the keys (out).
 
 @group(0) @binding(8) var<storage, read_write> keys: array<u32>;
@@ -35,45 +35,6 @@ fn spread2(x: u32) -> u32 {
     return (v | (v << 1u)) & 0x55555555u;
 }
 
-// 64-bit words as (low, high) pairs of u32, for the mixing function.
-fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
-    let lo = a.x + b.x;
-    return vec2<u32>(lo, a.y + b.y + select(0u, 1u, lo < a.x));
-}
-
-// The full 64-bit product of two u32, from 16-bit halves.
-fn mul_wide(a: u32, b: u32) -> vec2<u32> {
-    let al = a & 0xffffu;
-    let ah = a >> 16u;
-    let bl = b & 0xffffu;
-    let bh = b >> 16u;
-    let p0 = al * bl;
-    let p1 = al * bh;
-    let p2 = ah * bl;
-    let p3 = ah * bh;
-    let mid = (p0 >> 16u) + (p1 & 0xffffu) + (p2 & 0xffffu);
-    return vec2<u32>((mid << 16u) | (p0 & 0xffffu), p3 + (p1 >> 16u) + (p2 >> 16u) + (mid >> 16u));
-}
-
-// `wrapping_mul` of two 64-bit words.
-fn mul64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
-    let low = mul_wide(a.x, b.x);
-    return vec2<u32>(low.x, low.y + a.x * b.y + a.y * b.x);
-}
-
-// `z ^ (z >> s)` for 0 < s < 32.
-fn xorshift64(z: vec2<u32>, s: u32) -> vec2<u32> {
-    return z ^ vec2<u32>((z.x >> s) | (z.y << (32u - s)), z.y >> s);
-}
-
-// `ray_hash::mix`: the splitmix64 finalizer, low 32 bits.
-fn mix64(id: vec2<u32>) -> u32 {
-    var z = add64(id, vec2<u32>(0x7f4a7c15u, 0x9e3779b9u));
-    z = mul64(xorshift64(z, 30u), vec2<u32>(0x1ce4e5b9u, 0xbf58476du));
-    z = mul64(xorshift64(z, 27u), vec2<u32>(0x133111ebu, 0x94d049bbu));
-    return xorshift64(z, 31u).x;
-}
-
 // `RayGrid::direction_cell`: the cube face, then the Morton-ordered position on it.
 fn direction_cell(d: vec3<f32>) -> u32 {
     let a = abs(d);
@@ -104,17 +65,10 @@ fn ray_key(r: Ray) -> u32 {
     let cz = min(saturating_u32(rel.z), S.v1.z - 1u);
     let origin = spread3(cx) | (spread3(cy) << 1u) | (spread3(cz) << 2u);
     let dir = direction_cell(r.dir);
-    let bits = S.v1.w;
-    // `(dir << bits) | origin` as a 64-bit word (bits is at most 30).
-    var high = 0u;
-    if bits > 0u {
-        high = dir >> (32u - bits);
-    }
-    let id = vec2<u32>((dir << bits) | origin, high);
-    var key = id.x;
-    if S.v2.z == 0u {
-        key = mix64(id);
-    }
+    // The exact cell pair, the origin code's lowest `S.v2.z` bits dropped where the pair would
+    // not fit 32 bits (`RayGrid::origin_drop`).
+    let kept = S.v1.w - S.v2.z;
+    let key = (dir << kept) | (origin >> S.v2.z);
     // The untraceable key is reserved.
     return min(key, 0xfffffffeu);
 }

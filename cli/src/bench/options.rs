@@ -5,7 +5,7 @@ use super::view::ViewChoice;
 use crate::args::{LoadFlags, BUILDERS};
 use clap::Parser;
 use raytrail::core::method::Method;
-use raytrail::core::stream::StreamParams;
+use raytrail::core::stream::{StreamParams, MAX_PACKET};
 use raytrail::{Builder, BUILTIN_SCENE};
 
 /// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
@@ -266,8 +266,8 @@ fn stream_params(packets: Option<&str>, cells: Option<&str>) -> Result<Vec<Strea
         Some(v) => list(v)
             .iter()
             .map(|n| match n.parse::<u32>() {
-                Ok(k) if (1..=1 << 20).contains(&k) => Ok(k),
-                _ => Err(format!("--stream-packet: '{n}' is not a packet size between 1 and 2^20")),
+                Ok(k) if (1..=MAX_PACKET).contains(&k) => Ok(k),
+                _ => Err(format!("--stream-packet: '{n}' is not a packet size between 1 and {MAX_PACKET}")),
             })
             .collect::<Result<_, _>>()?,
     };

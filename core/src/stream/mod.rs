@@ -27,5 +27,5 @@ pub mod traverse;
 pub use exec::{Parallel, Serial};
 pub use frustum::{Frustum, FrustumCull, FrustumTest};
 pub use levels::{LevelBvh, LevelNode};
-pub use params::StreamParams;
+pub use params::{StreamParams, MAX_PACKET};
 pub use pipeline::{trace_stream, StageSeconds, StreamOutput, StreamPlan, StreamScene, StreamStats};

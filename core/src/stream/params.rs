@@ -1,5 +1,10 @@
 use crate::Error;
 
+/// The largest packet: a packet's frustum is built by one GPU invocation looping over its rays
+/// twice, and a shader's loops must stay well short of what a driver allows (Mesa's lavapipe was
+/// seen to stop them after about 32,768 iterations in all). The paper's packets hold at most 512.
+pub const MAX_PACKET: u32 = 8192;
+
 /// The stream method's parameters (Garanzha & Loop 2010, Sec. 3.1 and 5.1). Compared and hashed
 /// by the bits of the fractions.
 #[derive(Clone, Copy, Debug)]
@@ -11,7 +16,7 @@ pub struct StreamParams {
     /// face of the unit cube they point through, so the rays of one cell share their dominant
     /// axis (the frustum's). 1/16 by default.
     pub direction_cell_fraction: f32,
-    /// Most rays per packet (the paper's MaxSize; 256 by default).
+    /// Most rays per packet (the paper's MaxSize; 256 by default; at most [`MAX_PACKET`]).
     pub max_packet: u32,
     /// Leaf lists longer than this are intersected in pieces of this many leaves, in parallel,
     /// and merged by the closest-hit rule (the paper's remedy for a frustum that captures most
@@ -38,8 +43,8 @@ impl StreamParams {
                 why: "must be positive and finite",
             });
         }
-        if self.max_packet == 0 {
-            return Err(Error::InvalidParameter { name: "packet size", why: "must be at least 1" });
+        if self.max_packet == 0 || self.max_packet > MAX_PACKET {
+            return Err(Error::InvalidParameter { name: "packet size", why: "must be between 1 and 8192" });
         }
         if self.split_leaves == 0 {
             return Err(Error::InvalidParameter { name: "leaf-list piece size", why: "must be at least 1" });

@@ -5,11 +5,12 @@ use super::compose::StreamKernel;
 use super::run::{Run, StageUniform};
 use super::sort::{compress, decompress, packets, radix_sort};
 use super::traverse::{traverse, GpuLeafLists};
+use raytrail_core::glam::Vec3;
 use raytrail_core::stream::pipeline::StreamPlan;
 use raytrail_core::stream::ray_hash::RayGrid;
 use raytrail_core::stream::traverse::{LeafLists, PairQueue};
 use raytrail_core::stream::{Frustum, StreamParams, StreamScene};
-use raytrail_core::Error;
+use raytrail_core::{Error, Ray};
 
 /// Words of a frustum (`Frustum` is 80 bytes).
 const FRUSTUM_WORDS: u32 = 20;
@@ -44,7 +45,7 @@ pub(crate) fn plan(
     stage.v = [
         [lx, ly, lz, grid.inv_cell.to_bits()],
         [grid.cells[0], grid.cells[1], grid.cells[2], grid.origin_bits],
-        [grid.dir_cells, grid.face_bits, u32::from(grid.exact), 0],
+        [grid.dir_cells, grid.face_bits, grid.origin_drop, 0],
     ];
     run.dispatch(StreamKernel::Keys, n, stage, &[&keys])?;
     let chunks = compress(run, &keys, n)?;
@@ -65,7 +66,8 @@ pub(crate) fn plan(
 }
 
 /// The plan's arrays read back, in the core's form.
-pub(crate) fn read_plan(run: &mut Run<'_>, plan: &GpuPlan, n: u32) -> Result<StreamPlan, Error> {
+pub(crate) fn read_plan(run: &mut Run<'_>, plan: &GpuPlan, rays: &[Ray]) -> Result<StreamPlan, Error> {
+    let n = rays.len() as u32;
     let p = plan.packets;
     let l = &plan.lists;
     let back = run.read(&[
@@ -84,5 +86,9 @@ pub(crate) fn read_plan(run: &mut Run<'_>, plan: &GpuPlan, n: u32) -> Result<Str
     let pairs = PairQueue { frustum: next(), node: next() };
     let ranges = next().chunks_exact(2).map(|r| [r[0], r[1]]).collect();
     let lists = LeafLists { pairs, ranges, queue_sizes: l.queue_sizes.clone(), box_tests: l.box_tests };
-    Ok(StreamPlan { keys, order, packets, frustums, lists })
+    // The device reads rays through `order` and keeps no sorted copy; the core's plan has one.
+    // An index out of range (a device fault) shows as an untraceable ray rather than a panic.
+    let lost = Ray::new(Vec3::NAN, Vec3::NAN, 0.0, 0.0);
+    let sorted_rays = order.iter().map(|&i| rays.get(i as usize).copied().unwrap_or(lost)).collect();
+    Ok(StreamPlan { keys, order, sorted_rays, packets, frustums, lists })
 }

@@ -87,7 +87,7 @@ pub(crate) fn plan_only(
         let (mut run, s) = start(gpu, kernels, scene, StreamMethod::Frustum8, rays, 0)?;
         let n = rays.len() as u32;
         let p = plan(&mut run, &s, n, params)?;
-        read_plan(&mut run, &p, n)
+        read_plan(&mut run, &p, rays)
     })?
 }
 
@@ -119,8 +119,15 @@ fn trace_checked(
     let p = plan(&mut run, &s, n, &options.stream)?;
     run.next_stage(3)?;
     let l = &p.lists;
-    let stage = StageUniform::items(n).a(p.packets);
-    run.dispatch(StreamKernel::intersect(method, options), n, stage, &[&p.order, &p.bounds, &l.ranges, &l.node])?;
+    // Rounds of at most `split_leaves` leaves per invocation, enough for the longest list.
+    let ranges = run.read(&[(&l.ranges, 0, 2 * p.packets)])?.pop().unwrap_or_default();
+    let largest_list = ranges.chunks_exact(2).map(|r| r[1]).max().unwrap_or(0);
+    let per = options.stream.split_leaves.max(1);
+    for round in 0..largest_list.div_ceil(per).max(1) {
+        let mut stage = StageUniform::items(n).a(p.packets);
+        stage.v[0] = [round, per, 0, 0];
+        run.dispatch(StreamKernel::intersect(method, options), n, stage, &[&p.order, &p.bounds, &l.ranges, &l.node])?;
+    }
     let (hit_buffer, record_buffer) = run.outputs();
     let (hit_buffer, record_buffer) = (hit_buffer.clone(), record_buffer.clone());
     // Both fit 32-bit word counts: `start` bounded their bytes by a binding's size.
@@ -134,7 +141,9 @@ fn trace_checked(
         active_frustums: l.active as usize,
         queue_sizes: l.queue_sizes.clone(),
         leaf_refs: l.len as usize,
+        largest_list: largest_list as usize,
         box_tests: l.box_tests,
+        // The CPU's figure less its gathered copy of the rays: the device reads them through `order`.
         working_bytes: 4 * (2 * rays.len() + p.packets as usize + 1)
             + p.packets as usize * core::mem::size_of::<Frustum>()
             + 2 * 8 * l.biggest as usize,
