@@ -2,6 +2,7 @@
 
 use super::target::{BenchTarget, TargetKind, Work};
 use raytrail::core::method::{Method, Query};
+use raytrail::core::stream::StreamStats;
 use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::gpu::{WgpuBackend, WgpuScene};
@@ -66,5 +67,15 @@ impl BenchTarget for RaytrailGpu {
         let Some(c) = self.run(rays, query, &mut hits, Record::Counters)?.counters else { return Ok(None) };
         let per_ray = |x: u64| Some(x as f64 / c.rays.max(1) as f64);
         Ok(Some(Work { nodes: per_ray(c.nodes()), leaves: per_ray(c.leaves), tests: per_ray(c.primitive_tests) }))
+    }
+
+    /// The stream method's stages, from GPU timestamps where the adapter has them (one untimed
+    /// pass: the kernels' times vary far less than a shared CPU's).
+    fn stream_stats(&self, _pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<StreamStats>, String> {
+        if self.method.stream().is_none() {
+            return Ok(None);
+        }
+        let mut hits = vec![Hit::MISS; rays.len()];
+        Ok(self.run(rays, query, &mut hits, Record::Nothing)?.stream)
     }
 }
