@@ -71,7 +71,12 @@ impl BenchTarget for RaytrailGpu {
 
     /// The stream method's stages, from GPU timestamps where the adapter has them (one untimed
     /// pass: the kernels' times vary far less than a shared CPU's).
-    fn stream_stats(&self, _pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<StreamStats>, String> {
+    fn stream_stats(
+        &self,
+        _pool: &rayon::ThreadPool,
+        rays: &[Ray],
+        query: Query,
+    ) -> Result<Option<StreamStats>, String> {
         if self.method.stream().is_none() {
             return Ok(None);
         }

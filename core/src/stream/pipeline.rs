@@ -124,7 +124,7 @@ pub fn plan<P: Parallel, F: FrustumTest>(
     let mut chunks = compress(&keys);
     exec.sort_chunks(&mut chunks);
     let order = decompress(&chunks, keys.len());
-    let sorted: Vec<u32> = order.iter().map(|&i| keys[i as usize]).collect();
+    let sorted = exec.map(order.len(), |i| keys[order[i] as usize]);
     let bounds = packets(&sorted, params.max_packet);
     let sorted_rays = exec.map(order.len(), |i| rays[order[i] as usize]);
     seconds.sort = seconds_since(Some(t0));

@@ -31,21 +31,23 @@ impl Chunks {
 
 /// Compression (Fig. 4): head flags where a key differs from the one before, their exclusive scan
 /// as each run's slot, compaction of the runs' keys and bases into those slots, sizes as the
-/// differences of consecutive bases.
+/// differences of consecutive bases. On one thread the exclusive scan of the head flags is the
+/// count of runs met so far, so the slots are filled in one pass (a GPU runs the flags, the scan
+/// and the scatter as three kernels, and gets the same arrays).
 pub fn compress(keys: &[u32]) -> Chunks {
-    let heads: Vec<u32> = keys.iter().enumerate().map(|(i, &k)| u32::from(i == 0 || keys[i - 1] != k)).collect();
-    let (slot, count) = exclusive_scan(&heads);
-    let mut out = Chunks { key: vec![0; count as usize], base: vec![0; count as usize], size: vec![0; count as usize] };
-    for (i, &h) in heads.iter().enumerate() {
-        if h == 1 {
-            out.key[slot[i] as usize] = keys[i];
-            out.base[slot[i] as usize] = i as u32;
+    let mut out = Chunks::default();
+    for (i, &k) in keys.iter().enumerate() {
+        if i == 0 || keys[i - 1] != k {
+            out.key.push(k);
+            out.base.push(i as u32);
         }
     }
-    for c in 0..out.len() {
-        let end = out.base.get(c + 1).copied().unwrap_or(keys.len() as u32);
-        out.size[c] = end - out.base[c];
-    }
+    out.size = out
+        .base
+        .iter()
+        .enumerate()
+        .map(|(c, &b)| out.base.get(c + 1).copied().unwrap_or(keys.len() as u32) - b)
+        .collect();
     out
 }
 
@@ -78,19 +80,16 @@ pub fn radix_sort(chunks: &mut Chunks) {
 /// Decompression (Fig. 5): the exclusive scan of the sorted chunks' sizes gives each chunk's
 /// first sorted position; a skeleton of ones holds each chunk's base there, and the inclusive
 /// segmented scan of the skeleton, segments headed by those positions, is the sorted order of
-/// the `n` rays.
+/// the `n` rays. On one thread that segmented scan writes each chunk's `base, base + 1, ...` in
+/// turn, which is what this does in one pass (a GPU runs the scan, the skeleton and the
+/// segmented scan as kernels, and gets the same array).
 pub fn decompress(chunks: &Chunks, n: usize) -> Vec<u32> {
-    let (starts, _) = exclusive_scan(&chunks.size);
-    let mut skeleton = vec![1u32; n];
-    let mut heads = vec![false; n];
-    for (c, &s) in starts.iter().enumerate() {
-        if let Some(slot) = skeleton.get_mut(s as usize) {
-            *slot = chunks.base[c];
-            heads[s as usize] = true;
-        }
+    let mut out = Vec::with_capacity(n);
+    for (&base, &size) in chunks.base.iter().zip(&chunks.size) {
+        out.extend(base..base + size);
     }
-    segmented_inclusive_scan(&mut skeleton, &heads);
-    skeleton
+    out.truncate(n);
+    out
 }
 
 /// The whole scheme: the sorted order of rays with these keys (stable: equal keys keep their
