@@ -11,20 +11,22 @@ use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::FastKernel;
 use raytrail_core::{Error, Hit, Ray};
 
-/// Stage items on rayon's current pool. Small stages stay on the calling thread, where splitting
-/// would cost more than the work.
+/// Stage items on rayon's current pool.
 struct Rayon;
 
-/// Below this many items a stage runs serially.
-const SERIAL_BELOW: usize = 512;
+/// From this many items on, a task takes at least [`MIN_PER_TASK`] of them: such stages map cheap
+/// items (a ray's key), and one per task would cost more in scheduling than in work. Fewer items
+/// are heavy ones (a run of 2048 traversal pairs, a packet), and each may be a task of its own:
+/// a limit of 512 items here once left a traversal level of 244 runs on one thread.
+const MANY_ITEMS: usize = 1 << 16;
+
+/// Items per task in a stage of [`MANY_ITEMS`] or more.
+const MIN_PER_TASK: usize = 64;
 
 impl Parallel for Rayon {
     fn map<T: Send>(&self, n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-        if n < SERIAL_BELOW {
-            (0..n).map(f).collect()
-        } else {
-            (0..n).into_par_iter().with_min_len(64).map(f).collect()
-        }
+        let min = if n >= MANY_ITEMS { MIN_PER_TASK } else { 1 };
+        (0..n).into_par_iter().with_min_len(min).map(f).collect()
     }
 
     /// A parallel sort of (key, chunk index) pairs packed in a `u64`: the chunks come in base

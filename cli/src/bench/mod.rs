@@ -292,7 +292,7 @@ mod tests {
         // 3 methods, 3 peers with 2 variants each, and Embree (own test only) with its feature.
         let rows = if cfg!(feature = "embree") { 10 } else { 9 };
         for s in &views {
-            assert_eq!(s.rays.len(), 4);
+            assert_eq!(s.rays.len(), rays::RayKind::ALL.len());
             assert!(s.builds.iter().any(|b| b.what.starts_with("obvhs-cwbvh")));
             assert_eq!(s.builds.iter().any(|b| b.what.starts_with("embree")), cfg!(feature = "embree"));
             for r in &s.rays {
