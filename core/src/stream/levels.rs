@@ -169,13 +169,12 @@ impl LevelBvh {
         self.canonical.get(index as usize).copied().unwrap_or(u32::MAX)
     }
 
-    /// The reference an observer records for node `index`: a leaf by its first triangle.
+    /// The reference an observer records for node `index`: a leaf by its first triangle (an
+    /// index past the nodes is named as an internal node, which no recording matches).
     pub fn node_ref(&self, index: u32) -> NodeRef {
-        let n = &self.nodes[index as usize];
-        if n.is_leaf() {
-            NodeRef::leaf(n.first)
-        } else {
-            NodeRef::internal(index)
+        match self.nodes.get(index as usize) {
+            Some(n) if n.is_leaf() => NodeRef::leaf(n.first),
+            _ => NodeRef::internal(index),
         }
     }
 

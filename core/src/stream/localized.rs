@@ -23,8 +23,14 @@ fn near_side(n: &LevelNode, (a, negative): (usize, bool)) -> f32 {
 
 /// The order [`intersect_packet`] visits `leaves` in: by the near side of each leaf's box along
 /// the frustum's axis (`frustum_axis`: the axis and whether the rays run toward its negative end),
-/// ties by list position; the list order where the frustum has no axis.
+/// ties by list position; the list order where the frustum has no axis. Entries that name no leaf
+/// of `tree` are left out.
 pub fn visiting_order(tree: &LevelBvh, leaves: &[u32], frustum_axis: Option<(usize, bool)>) -> Vec<u32> {
+    // Only leaves of the tree are visited: an index past the nodes, or of an internal node, is
+    // dropped (only a damaged list has one).
+    let leaves: Vec<u32> =
+        leaves.iter().copied().filter(|&l| tree.nodes().get(l as usize).is_some_and(LevelNode::is_leaf)).collect();
+    let leaves = &leaves[..];
     let near = |leaf: u32, axis| near_side(&tree.nodes()[leaf as usize], axis);
     let mut order: Vec<u32> = leaves.to_vec();
     if let Some(axis) = frustum_axis {
@@ -136,5 +142,54 @@ pub fn intersect_packet<T: TriangleTest, K: ChildKernel, O: Observer>(
             }
         }
         *hit = q.hit;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh2::SahBuilder;
+    use crate::geometry::Triangle;
+    use crate::intersect::Watertight;
+    use crate::method::Collapse;
+    use crate::observe::NoObserver;
+    use crate::stream::frustum::Frustum;
+    use crate::stream::traverse::expand_pair;
+    use crate::wide::{ReferenceKernel, WideBvh};
+    use crate::Aabb;
+    use glam::Vec3;
+
+    /// A damaged leaf list (an index past the nodes, an internal node) or node index is skipped,
+    /// not a panic, and the valid leaves still give the hit.
+    #[test]
+    fn damaged_lists_are_skipped() {
+        let tris: Vec<Triangle> = (0..40)
+            .map(|i| {
+                let x = i as f32;
+                Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 0.0, 0.0), Vec3::new(x, 1.0, 0.0))
+            })
+            .collect();
+        let bvh = SahBuilder::default().build(&tris).expect("build");
+        let bounds = bvh.nodes()[0].bounds;
+        let wide = WideBvh::<8>::build(&bvh, &tris, Collapse::PullUp).expect("collapse");
+        let tree = LevelBvh::new(&wide, &bounds).expect("levels");
+        let leaves: Vec<u32> = (0..tree.nodes().len() as u32).filter(|&i| tree.nodes()[i as usize].is_leaf()).collect();
+        let damaged: Vec<u32> = [u32::MAX, 0].into_iter().chain(leaves.iter().copied()).collect();
+        let ray = Ray::new(Vec3::new(3.25, 0.25, 5.0), Vec3::new(0.0, 0.0, -1.0), 0.0, f32::INFINITY);
+        let mut hit = [Hit::MISS];
+        intersect_packet::<Watertight, ReferenceKernel, _>(
+            &tree,
+            &damaged,
+            Some((2, true)),
+            core::slice::from_ref(&ray),
+            Aabb::max_abs(&bounds),
+            Query::Closest,
+            &mut hit,
+            &mut NoObserver,
+        );
+        assert!(hit[0].is_hit() && hit[0].t == 5.0, "{:?}", hit[0]);
+        let mut out = [0u32; 8];
+        let f = Frustum::build(core::slice::from_ref(&ray).iter(), &bounds, bounds.max_abs());
+        assert_eq!(expand_pair::<crate::stream::FrustumCull>(tree.nodes(), &f, u32::MAX, &mut out), 0);
     }
 }

@@ -80,20 +80,25 @@ impl StreamPlan {
         self.packets.len().saturating_sub(1)
     }
 
-    /// The ray indices of packet `p`.
+    /// The ray indices of packet `p` (empty for a packet that does not exist).
     pub fn packet(&self, p: usize) -> &[u32] {
-        &self.order[self.packets[p] as usize..self.packets[p + 1] as usize]
+        self.packet_range(p).and_then(|r| self.order.get(r)).unwrap_or(&[])
     }
 
-    /// The rays of packet `p`, in sorted order.
+    /// The rays of packet `p`, in sorted order (empty for a packet that does not exist).
     pub fn packet_rays(&self, p: usize) -> &[Ray] {
-        &self.sorted_rays[self.packets[p] as usize..self.packets[p + 1] as usize]
+        self.packet_range(p).and_then(|r| self.sorted_rays.get(r)).unwrap_or(&[])
     }
 
-    /// The leaves (node indices) packet `p`'s frustum reached, in order.
+    /// The leaves (node indices) packet `p`'s frustum reached, in order (empty for a packet that
+    /// does not exist).
     pub fn leaves(&self, p: usize) -> &[u32] {
-        let [start, len] = self.lists.ranges[p];
-        &self.lists.pairs.node[start as usize..(start + len) as usize]
+        let Some(&[start, len]) = self.lists.ranges.get(p) else { return &[] };
+        self.lists.pairs.node.get(start as usize..(start as usize).saturating_add(len as usize)).unwrap_or(&[])
+    }
+
+    fn packet_range(&self, p: usize) -> Option<core::ops::Range<usize>> {
+        Some(*self.packets.get(p)? as usize..*self.packets.get(p + 1)? as usize)
     }
 }
 

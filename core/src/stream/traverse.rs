@@ -38,16 +38,18 @@ pub struct LeafLists {
 /// its own single child.
 #[inline]
 pub fn expand_pair<F: FrustumTest>(nodes: &[LevelNode], frustum: &Frustum, node: u32, out: &mut [u32; 8]) -> u32 {
-    let n = &nodes[node as usize];
+    // A node or child past the slice (only a damaged tree has one) expands to nothing.
+    let Some(n) = nodes.get(node as usize) else { return 0 };
     if n.is_leaf() {
         out[0] = node;
         return 1;
     }
     let mut keys = [0u32; 8];
     let mut count = 0;
-    for k in 0..n.children() {
-        let child = n.first + k;
-        let (lo, hi) = nodes[child as usize].bounds();
+    for k in 0..n.children().min(8) {
+        let child = n.first.wrapping_add(k);
+        let Some(c) = nodes.get(child as usize) else { continue };
+        let (lo, hi) = c.bounds();
         if F::overlaps(frustum, lo, hi) {
             // Key: the visiting rank in the high bits, the child's slot in the low ones.
             keys[count] = ((n.octant(k) ^ frustum.dir_signs) << 4) | k;
