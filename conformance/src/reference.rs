@@ -10,7 +10,7 @@ use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{KdMethod, Method, Query, StreamMethod};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::stream::{trace_stream, FrustumCull, Serial};
+use raytrail_core::stream::{trace_stream_with, FrustumCull, Serial};
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{ReferenceKernel, WideSliceMemory, WideTree};
@@ -116,29 +116,7 @@ impl SerialBackend {
     ) -> Result<Report, Error> {
         let s = scene.stream_scene(method)?;
         let start = Instant::now();
-        let enumerate = opts.record == Record::Enumerations;
-        let out = match opts.triangle_test {
-            TriangleTestKind::Watertight => trace_stream::<_, FrustumCull, Watertight, ReferenceKernel>(
-                &Serial,
-                &s,
-                rays,
-                hits,
-                opts.query,
-                &opts.stream,
-                true,
-                enumerate,
-            ),
-            TriangleTestKind::MollerTrumbore => trace_stream::<_, FrustumCull, MollerTrumbore, ReferenceKernel>(
-                &Serial,
-                &s,
-                rays,
-                hits,
-                opts.query,
-                &opts.stream,
-                true,
-                enumerate,
-            ),
-        }?;
+        let out = trace_stream_with::<_, FrustumCull, ReferenceKernel>(&Serial, &s, rays, hits, opts, true)?;
         let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());
         report.counters = (opts.record != Record::Nothing).then(|| {
             let mut c = out.counters.unwrap_or_default();

@@ -2,12 +2,11 @@
 //! leaf test (four triangles at once).
 
 use rayon::prelude::*;
-use raytrail_core::intersect::{MollerTrumbore, Watertight};
 use raytrail_core::method::StreamMethod;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::stream::sort::Chunks;
-use raytrail_core::stream::{trace_stream, FrustumCull, Parallel, StreamOutput};
-use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
+use raytrail_core::stream::{trace_stream_with, FrustumCull, Parallel, StreamOutput};
+use raytrail_core::trace::TraceOptions;
 use raytrail_core::wide::FastKernel;
 use raytrail_core::{Error, Hit, Ray};
 
@@ -51,27 +50,5 @@ pub(crate) fn trace(
     hits: &mut [Hit],
 ) -> Result<StreamOutput, Error> {
     let s = scene.stream_scene(method)?;
-    let (count, enumerate) = (opts.record != Record::Nothing, opts.record == Record::Enumerations);
-    match opts.triangle_test {
-        TriangleTestKind::Watertight => trace_stream::<_, FrustumCull, Watertight, FastKernel>(
-            &Rayon,
-            &s,
-            rays,
-            hits,
-            opts.query,
-            &opts.stream,
-            count,
-            enumerate,
-        ),
-        TriangleTestKind::MollerTrumbore => trace_stream::<_, FrustumCull, MollerTrumbore, FastKernel>(
-            &Rayon,
-            &s,
-            rays,
-            hits,
-            opts.query,
-            &opts.stream,
-            count,
-            enumerate,
-        ),
-    }
+    trace_stream_with::<_, FrustumCull, FastKernel>(&Rayon, &s, rays, hits, opts, false)
 }

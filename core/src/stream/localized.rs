@@ -30,34 +30,27 @@ pub fn visiting_order(tree: &LevelBvh, leaves: &[u32], frustum_axis: Option<(usi
     // dropped (only a damaged list has one).
     let leaves: Vec<u32> =
         leaves.iter().copied().filter(|&l| tree.nodes().get(l as usize).is_some_and(LevelNode::is_leaf)).collect();
-    let leaves = &leaves[..];
-    let near = |leaf: u32, axis| near_side(&tree.nodes()[leaf as usize], axis);
-    let mut order: Vec<u32> = leaves.to_vec();
-    if let Some(axis) = frustum_axis {
-        // Sorted by (near side, list position), packed in a `u64` with the float's bits made to
-        // order as integers: one sort of plain integers, no float comparisons.
-        let ordered_bits = |x: f32| {
-            let b = x.to_bits();
-            if b >> 31 == 1 {
-                !b
-            } else {
-                b | 1 << 31
-            }
-        };
-        let mut keyed: Vec<u64> = leaves
-            .iter()
-            .enumerate()
-            .map(|(i, &leaf)| {
-                let n = near(leaf, axis);
-                u64::from(ordered_bits(if axis.1 { -n } else { n })) << 32 | i as u64
-            })
-            .collect();
-        keyed.sort_unstable();
-        for (o, k) in order.iter_mut().zip(&keyed) {
-            *o = leaves[(k & 0xffff_ffff) as usize];
+    let Some(axis) = frustum_axis else { return leaves };
+    // Sorted by (near side, list position), packed in a `u64` with the float's bits made to order
+    // as integers: one sort of plain integers, no float comparisons.
+    let ordered_bits = |x: f32| {
+        let b = x.to_bits();
+        if b >> 31 == 1 {
+            !b
+        } else {
+            b | 1 << 31
         }
-    }
-    order
+    };
+    let mut keyed: Vec<u64> = leaves
+        .iter()
+        .enumerate()
+        .map(|(i, &leaf)| {
+            let n = near_side(&tree.nodes()[leaf as usize], axis);
+            u64::from(ordered_bits(if axis.1 { -n } else { n })) << 32 | i as u64
+        })
+        .collect();
+    keyed.sort_unstable();
+    keyed.iter().map(|k| leaves[(k & 0xffff_ffff) as usize]).collect()
 }
 
 /// Traces `rays` (a packet's, in sorted order) against the leaves `leaves` (node indices, in

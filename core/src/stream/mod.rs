@@ -28,4 +28,4 @@ pub use exec::{Parallel, Serial};
 pub use frustum::{Frustum, FrustumCull, FrustumTest};
 pub use levels::{LevelBvh, LevelNode};
 pub use params::{StreamParams, MAX_PACKET};
-pub use pipeline::{trace_stream, StageSeconds, StreamOutput, StreamPlan, StreamScene, StreamStats};
+pub use pipeline::{trace_stream, trace_stream_with, StageSeconds, StreamOutput, StreamPlan, StreamScene, StreamStats};

@@ -11,10 +11,11 @@ use super::ray_hash::RayGrid;
 use super::sort::{compress, decompress, packets};
 use super::traverse::{traverse, LeafLists};
 use super::StreamParams;
-use crate::intersect::TriangleTest;
+use crate::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use crate::method::Query;
 use crate::observe::{Counters, NoObserver, Observer};
 use crate::prepared::seconds_since;
+use crate::trace::{Record, TraceOptions, TriangleTestKind};
 use crate::wide::ChildKernel;
 use crate::{Aabb, Error, Hit, Ray};
 use alloc::vec;
@@ -210,6 +211,30 @@ pub fn trace_stream<P: Parallel, F: FrustumTest, T: TriangleTest, K: ChildKernel
         seconds,
     };
     Ok(StreamOutput { stats, counters, enumerations })
+}
+
+/// [`trace_stream`] with the triangle test `options` name, its query and stream parameters;
+/// counts when `options` records anything, enumerates when it records enumerations (`count`
+/// forces counting, as the serial reference always does).
+pub fn trace_stream_with<P: Parallel, F: FrustumTest, K: ChildKernel>(
+    exec: &P,
+    scene: &StreamScene<'_>,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    options: &TraceOptions,
+    count: bool,
+) -> Result<StreamOutput, Error> {
+    let count = count || options.record != Record::Nothing;
+    let enumerate = options.record == Record::Enumerations;
+    let (query, params) = (options.query, &options.stream);
+    match options.triangle_test {
+        TriangleTestKind::Watertight => {
+            trace_stream::<P, F, Watertight, K>(exec, scene, rays, hits, query, params, count, enumerate)
+        }
+        TriangleTestKind::MollerTrumbore => {
+            trace_stream::<P, F, MollerTrumbore, K>(exec, scene, rays, hits, query, params, count, enumerate)
+        }
+    }
 }
 
 /// Stage four over every packet, the hits put back in ray order; the observers' sum.
