@@ -1,11 +1,11 @@
-// The kernel: one invocation per ray. The method file defines `trace`.
+// Work items of the one-ray-per-item kernels: item `i` is ray `i` of the batch. The method file
+// defines `trace`; a dispatch file (`dispatch_grid` or `dispatch_persistent`) hands out the items.
 
-@compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x + gid.y * P.row_width;
-    if i >= P.ray_count {
-        return;
-    }
+fn item_count() -> u32 {
+    return P.ray_count;
+}
+
+fn run_item(i: u32) {
     rec_begin(i);
     hits[i] = trace(rays[i]);
 }

@@ -186,6 +186,21 @@ fn packet_step(capacity: u32) {
 
 // Traces rays `base .. base + n` (n <= 4; lanes from n on stay done, like the CPU's short packet).
 fn trace_packet(base: u32, n: u32) {
+    // Everything a packet reads starts from zero, as private memory does when an invocation
+    // starts: with persistent threads one invocation traces many packets, and a lane without a
+    // traceable ray copies `C` and `TR` as they were.
+    C = Ctx();
+    TR = TriRay();
+    PK_C = array<Ctx, 4>();
+    PK_TR = array<TriRay, 4>();
+    PK_HIT = array<Hit, 4>();
+    PK_STACK = array<PacketEntry, SHORT_STACK_MAX>();
+    PK_RESUME = vec4<f32>(0.0);
+    PK_WANT_FIRST = 0u;
+    PK_WANT_SECOND = 0u;
+    PK_SPLIT = vec4<f32>(0.0);
+    PK_FIRST_CHILD = 0u;
+    PK_SECOND_CHILD = 0u;
     PK_BASE = base;
     PK_T_MIN = vec4<f32>(0.0);
     PK_T_MAX = vec4<f32>(0.0);
@@ -227,12 +242,13 @@ fn trace_packet(base: u32, n: u32) {
     }
 }
 
-// One invocation per packet: packet p holds rays 4p .. 4p + 3 of the batch.
-@compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let base = (gid.x + gid.y * P.row_width) * PACKET_WIDTH;
-    if base >= P.ray_count {
-        return;
-    }
+// Work items of the packet kernel: item `p` is packet p, rays 4p .. 4p + 3 of the batch (as
+// `entry.wgsl` is for the one-ray kernels; a dispatch file hands out the items).
+fn item_count() -> u32 {
+    return (P.ray_count + PACKET_WIDTH - 1u) / PACKET_WIDTH;
+}
+
+fn run_item(p: u32) {
+    let base = p * PACKET_WIDTH;
     trace_packet(base, min(PACKET_WIDTH, P.ray_count - base));
 }

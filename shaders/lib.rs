@@ -37,6 +37,13 @@ pub const BVH_RESUME: Source = Source { name: "bvh_resume.wgsl", text: include_s
 /// `bvh_stack.wgsl`.
 pub const BVH_STACK: Source = Source { name: "bvh_stack.wgsl", text: include_str!("bvh_stack.wgsl") };
 
+/// `dispatch_grid.wgsl`.
+pub const DISPATCH_GRID: Source = Source { name: "dispatch_grid.wgsl", text: include_str!("dispatch_grid.wgsl") };
+
+/// `dispatch_persistent.wgsl`.
+pub const DISPATCH_PERSISTENT: Source =
+    Source { name: "dispatch_persistent.wgsl", text: include_str!("dispatch_persistent.wgsl") };
+
 /// `entry.wgsl`.
 pub const ENTRY: Source = Source { name: "entry.wgsl", text: include_str!("entry.wgsl") };
 
@@ -182,6 +189,8 @@ pub const ALL: &[Source] = &[
     BVH_REGISTER_RUN,
     BVH_RESUME,
     BVH_STACK,
+    DISPATCH_GRID,
+    DISPATCH_PERSISTENT,
     ENTRY,
     FALLBACK_HASH,
     FALLBACK_UNCLE,

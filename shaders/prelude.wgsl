@@ -50,7 +50,8 @@ struct Params {
     kd_tris: u32,
     // Wide BVH: the root leaf's triangle count (0: the root is node `root`).
     wide_root_count: u32,
-    _pad1: u32,
+    // Persistent threads: rounds a workgroup fetches at most (dispatch_persistent.wgsl).
+    persistent_rounds: u32,
     // kd: scene box.
     kd_lo: vec4<f32>,
     kd_hi: vec4<f32>,

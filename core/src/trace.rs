@@ -97,9 +97,14 @@ impl TraceOptions {
 pub struct Report {
     /// Rays traced.
     pub rays: usize,
-    /// Seconds of the traversal (0 where the backend has no clock); each backend documents
-    /// whether this is wall-clock or device time.
+    /// Wall-clock seconds of the call, end to end: for a device backend, transfers included (0
+    /// where the backend has no clock).
     pub seconds: f64,
+    /// Seconds the device spent in the trace's kernels alone (GPU timestamps), where a device
+    /// backend measured them; `None` on the host backends and on adapters without timestamps.
+    pub kernel_seconds: Option<f64>,
+    /// Bytes copied between host and device memory by the call (0 on the host backends).
+    pub transfer_bytes: u64,
     /// Work counters ([`Record::Counters`] and [`Record::Enumerations`]).
     pub counters: Option<Counters>,
     /// Per-ray node enumerations ([`Record::Enumerations`]).
@@ -111,7 +116,15 @@ pub struct Report {
 impl Report {
     /// A report of `rays` rays traced in `seconds`, recording nothing.
     pub fn new(rays: usize, seconds: f64) -> Self {
-        Self { rays, seconds, counters: None, enumerations: None, stream: None }
+        Self {
+            rays,
+            seconds,
+            kernel_seconds: None,
+            transfer_bytes: 0,
+            counters: None,
+            enumerations: None,
+            stream: None,
+        }
     }
 
     /// Millions of rays per second.

@@ -1,22 +1,20 @@
 //! The wgpu backend: the [`Trace`] implementation.
 
-use crate::batch::{self, SceneBindings};
-use crate::compose::Variant;
+use crate::batch;
+use crate::config::GpuConfig;
 use crate::device::{device_error, Gpu, KernelForm};
-use crate::params::Params;
+use crate::launch::{self, Arranged};
 use crate::pipelines::Pipelines;
 use crate::record;
 use crate::scene::WgpuScene;
 use crate::stream::kernels::StreamKernels;
+use crate::workspace::{HIT_BYTES, RAY_BYTES};
 use raytrail_core::bvh2::NodeRef;
-use raytrail_core::kd::traverse::packets::{packet_slots, PADDING};
-use raytrail_core::kd::traverse::PACKET_WIDTH;
-use raytrail_core::method::{KdMethod, Method};
+use raytrail_core::method::Method;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::stream::{StreamParams, StreamPlan};
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
-use raytrail_core::wide::WideChild;
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::Arc;
 use std::time::Instant;
@@ -28,18 +26,15 @@ const DEFAULT_RECORD_CAP: usize = 256;
 /// The most node events a ray may record: far beyond any intact tree's enumeration.
 const MAX_RECORD_CAP: usize = 1 << 24;
 
-/// Bytes of per-batch buffers (rays, hits, records) the backend aims to stay under.
-const BATCH_BYTES: usize = 256 << 20;
-
-/// Rays per packet of the kd-packet kernel: the core's packet width.
-const PACKET: usize = PACKET_WIDTH;
-
-/// The wgpu backend: one device, kernels compiled on first use.
+/// The wgpu backend: one device, kernels compiled on first use, and how traces are spread over
+/// the device ([`GpuConfig`]). Backends made by [`WgpuBackend::configured`] share the device and
+/// the compiled kernels.
 pub struct WgpuBackend {
-    gpu: Gpu,
-    pipelines: Pipelines,
+    pub(crate) gpu: Arc<Gpu>,
+    pub(crate) pipelines: Arc<Pipelines>,
     /// The stream method's kernels, or why the adapter cannot run them.
-    stream: Result<StreamKernels, String>,
+    stream: Arc<Result<StreamKernels, String>>,
+    pub(crate) config: GpuConfig,
 }
 
 impl WgpuBackend {
@@ -54,7 +49,30 @@ impl WgpuBackend {
         let gpu = Gpu::open(form)?;
         let pipelines = Pipelines::new(&gpu);
         let stream = StreamKernels::new(&gpu).map_err(|e| e.to_string());
-        Ok(WgpuBackend { gpu, pipelines, stream })
+        Ok(WgpuBackend {
+            gpu: Arc::new(gpu),
+            pipelines: Arc::new(pipelines),
+            stream: Arc::new(stream),
+            config: GpuConfig::default(),
+        })
+    }
+
+    /// This backend's device and kernels with other settings (batch size, batches in flight,
+    /// dispatch, workgroup size); an error names a setting outside the adapter's limits. Scenes
+    /// prepared by either backend serve both.
+    pub fn configured(&self, config: GpuConfig) -> Result<WgpuBackend, Error> {
+        config.check(&self.gpu.limits)?;
+        Ok(WgpuBackend {
+            gpu: self.gpu.clone(),
+            pipelines: self.pipelines.clone(),
+            stream: self.stream.clone(),
+            config,
+        })
+    }
+
+    /// The settings traces run with.
+    pub fn config(&self) -> &GpuConfig {
+        &self.config
     }
 
     /// The adapter, for reports.
@@ -62,8 +80,7 @@ impl WgpuBackend {
         self.gpu.describe()
     }
 
-    /// Whether [`Report::seconds`] are GPU time from timestamp queries (otherwise wall-clock time
-    /// of the whole call, transfers included).
+    /// Whether [`Report::kernel_seconds`] are measured (GPU timestamps around every batch).
     pub fn has_gpu_timer(&self) -> bool {
         self.gpu.timestamps
     }
@@ -80,12 +97,14 @@ impl WgpuBackend {
         if let Method::Stream(m) = method {
             return self.stream_kernels()?.warm_up(&self.gpu, m, options);
         }
-        self.pipelines.get(&self.gpu, &variant(scene, method, options)).map(|_| ())
+        let mut options = *options;
+        options.method = method;
+        self.pipelines.get(&self.gpu, &launch::variant(scene, &options, &self.config)).map(|_| ())
     }
 
     /// The stream method's kernels, or [`Error::Device`] naming why the adapter cannot run them.
-    fn stream_kernels(&self) -> Result<&StreamKernels, Error> {
-        self.stream.as_ref().map_err(|why| device_error(format!("the stream method is unavailable: {why}")))
+    pub(crate) fn stream_kernels(&self) -> Result<&StreamKernels, Error> {
+        self.stream.as_ref().as_ref().map_err(|why| device_error(format!("the stream method is unavailable: {why}")))
     }
 
     /// The stream method's stages one to three on the device (keys, sorted order, packet bounds,
@@ -95,144 +114,36 @@ impl WgpuBackend {
         crate::stream::plan_only(&self.gpu, self.stream_kernels()?, scene, rays, params)
     }
 
-    /// Rays per batch: within the adapter's binding and dispatch limits and the byte budget.
-    fn batch_rays(&self, record_stride: usize) -> usize {
-        let l = &self.gpu.limits;
-        let per_ray = 32 + 16 + 4 * record_stride;
-        let binding = l.max_storage_buffer_binding_size as usize;
-        let by_binding = (binding / 32).min(binding / (4 * record_stride.max(1)));
-        let by_dispatch = l.max_compute_workgroups_per_dimension as usize * 64 * 1024;
-        let n = (BATCH_BYTES / per_ray).min(by_binding).min(by_dispatch).max(PACKET);
-        n - n % PACKET
-    }
-
-    /// Traces `rays` with a record capacity of `cap` node events per ray.
+    /// Traces `rays` into `hits` with a record capacity of `cap` node events per ray; returns the
+    /// records (in ray order) and the batches' GPU seconds.
     fn trace_with_cap(
         &self,
         scene: &WgpuScene,
         rays: &[Ray],
         options: &TraceOptions,
         cap: usize,
-    ) -> Result<Traced, Error> {
-        let p = &scene.prepared;
-        let v = variant(scene, options.method, options);
-        let pipeline = self.pipelines.get(&self.gpu, &v)?;
-        let stride = match options.record {
-            Record::Nothing => 0,
-            Record::Counters => record::stride(0),
-            Record::Enumerations => record::stride(cap),
+        hits: &mut [Hit],
+    ) -> Result<batch::StreamOut, Error> {
+        let pipeline = self.pipelines.get(&self.gpu, &launch::variant(scene, options, &self.config))?;
+        let launch = launch::launch(scene, options, cap, &pipeline, &self.pipelines.bind_layout, self.config)?;
+        let mut ws = scene.workspace()?;
+        let Some(arranged) = Arranged::of(options.method, rays) else {
+            return batch::run(&self.gpu, &mut ws, &launch, rays, hits);
         };
-        let mut params = Params { record_stride: stride as u32, record_cap: cap as u32, ..Params::default() };
-        let bindings = match options.method {
-            Method::Bvh2(m) => {
-                let root = p.root(m)?;
-                let layout =
-                    scene.layout_for(m).ok_or(Error::NotPrepared { method: m.name(), missing: "its BVH2 layout" })?;
-                params.root = root.node.0;
-                params.max_steps = root.max_steps;
-                params.scene_scale = root.scene_scale;
-                params.leaf_base = layout.leaf_base;
-                let hash = match scene.hash_for(m) {
-                    Some(h) => {
-                        params.d_mask = h.d_mask;
-                        params.h = h.h;
-                        &h.buffer
-                    }
-                    None if m.needs_hash() => {
-                        return Err(Error::NotPrepared { method: m.name(), missing: "the hash tables" })
-                    }
-                    None => &scene.empty,
-                };
-                SceneBindings { bvh: &layout.buffer, hash, kd: &scene.empty }
-            }
-            Method::Kd(_) => {
-                let root = p.kd_root()?;
-                let kd = scene.kd.as_ref().ok_or(Error::NotPrepared { method: "kd", missing: "the kd-tree" })?;
-                params.max_steps = root.max_steps;
-                params.scene_scale = root.scene_scale;
-                params.short_stack = root.short_stack as u32;
-                params.kd_prims = kd.prims;
-                params.kd_tris = kd.tris;
-                params.kd_lo = [root.lo.x, root.lo.y, root.lo.z, 0.0];
-                params.kd_hi = [root.hi.x, root.hi.y, root.hi.z, 0.0];
-                SceneBindings { bvh: &scene.empty, hash: &scene.empty, kd: &kd.buffer }
-            }
-            Method::Wide(m) => {
-                let root = p.wide_root(m)?;
-                let tree =
-                    scene.wide_for(m).ok_or(Error::NotPrepared { method: m.name(), missing: "its wide tree" })?;
-                params.max_steps = root.max_steps;
-                params.scene_scale = root.scene_scale;
-                params.kd_prims = tree.prims;
-                params.kd_tris = tree.tris;
-                (params.root, params.wide_root_count) = match root.root {
-                    WideChild::Node(n) => (n, 0),
-                    WideChild::Leaf { first, count } => (NodeRef::leaf(first).0, count),
-                };
-                SceneBindings { bvh: &scene.empty, hash: &scene.empty, kd: &tree.buffer }
-            }
-            other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
-        };
-        // Packets are grouped as the core says (every backend alike): the batch is rearranged into
-        // the grouping's slots, padding as untraceable rays, so that packet `p` is slots
-        // `PACKET * p ..`, then put back.
-        let order = (options.method == Method::Kd(KdMethod::Packet)).then(|| packet_slots(rays));
-        let arranged: Vec<Ray>;
-        let work: &[Ray] = match &order {
-            Some(o) => {
-                let pad = Ray { origin: [f32::NAN; 3], tmin: 0.0, dir: [f32::NAN; 3], tmax: 0.0 };
-                arranged = o.iter().map(|&i| if i == PADDING { pad } else { rays[i as usize] }).collect();
-                &arranged
-            }
-            None => rays,
-        };
-        let per_batch = self.batch_rays(stride);
-        let mut hits = Vec::with_capacity(work.len());
-        let mut records = Vec::with_capacity(work.len() * stride);
-        let mut gpu_seconds = Some(0.0);
-        for chunk in work.chunks(per_batch) {
-            let invocations = if order.is_some() { chunk.len().div_ceil(PACKET) } else { chunk.len() };
-            let out =
-                batch::run(&self.gpu, &pipeline, &self.pipelines.bind_layout, &bindings, params, chunk, invocations)?;
-            hits.extend(out.hits);
-            records.extend(out.records);
-            gpu_seconds = gpu_seconds.zip(out.gpu_seconds).map(|(a, b)| a + b);
-        }
-        if let Some(o) = &order {
-            let mut h = vec![Hit::MISS; rays.len()];
-            let mut r = vec![0u32; rays.len() * stride];
-            for (slot, &i) in o.iter().enumerate() {
-                if i != PADDING {
-                    h[i as usize] = hits[slot];
-                    let (dst, src) = (i as usize * stride, slot * stride);
-                    r[dst..dst + stride].copy_from_slice(&records[src..src + stride]);
-                }
-            }
-            return Ok(Traced { hits: h, records: r, stride, gpu_seconds });
-        }
-        Ok(Traced { hits, records, stride, gpu_seconds })
+        let mut slot_hits = vec![Hit::MISS; arranged.rays.len()];
+        let out = batch::run(&self.gpu, &mut ws, &launch, &arranged.rays, &mut slot_hits)?;
+        arranged.restore(&slot_hits, 1, hits);
+        let stride = launch.params.record_stride as usize;
+        let mut records = vec![0u32; rays.len() * stride];
+        arranged.restore(&out.records, stride, &mut records);
+        Ok(batch::StreamOut { records, gpu_seconds: out.gpu_seconds })
     }
 }
 
-/// What [`WgpuBackend::trace_with_cap`] returns, in the caller's ray order.
-struct Traced {
-    hits: Vec<Hit>,
-    /// `stride` words per ray.
-    records: Vec<u32>,
-    stride: usize,
-    /// GPU seconds, when every batch was timed by timestamp queries.
-    gpu_seconds: Option<f64>,
-}
-
-/// The kernel variant for `method` on `scene` with `options`.
-fn variant(scene: &WgpuScene, method: Method, options: &TraceOptions) -> Variant {
-    Variant {
-        method,
-        keys: scene.prepared.key_width(),
-        triangle: options.triangle_test,
-        query: options.query,
-        record: options.record,
-    }
+/// Bytes a trace of `rays` rays moves between host and device: rays up, hits and `stride` record
+/// words per ray down.
+pub(crate) fn bytes_moved(rays: usize, stride: usize) -> u64 {
+    rays as u64 * (RAY_BYTES + HIT_BYTES + 4 * stride as u64)
 }
 
 /// Canonical ids of one ray's recorded references, by the core's convention.
@@ -278,14 +189,15 @@ impl Trace for WgpuBackend {
             return crate::stream::trace(&self.gpu, self.stream_kernels()?, scene, m, rays, options, hits);
         }
         let start = Instant::now();
-        let Traced { hits: out, records, stride, gpu_seconds } =
-            self.trace_with_cap(scene, rays, options, DEFAULT_RECORD_CAP)?;
-        let wall = start.elapsed().as_secs_f64();
-        hits.copy_from_slice(&out);
-        let mut report = Report::new(rays.len(), gpu_seconds.unwrap_or(wall));
+        let out = self.trace_with_cap(scene, rays, options, DEFAULT_RECORD_CAP, hits)?;
+        let stride = launch::record_stride(options, DEFAULT_RECORD_CAP);
+        let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());
+        report.kernel_seconds = out.gpu_seconds;
+        report.transfer_bytes = bytes_moved(rays.len(), stride);
         if options.record == Record::Nothing {
             return Ok(report);
         }
+        let records = out.records;
         let mut counters = Counters { rays: rays.len() as u64, ..Counters::default() };
         for slot in records.chunks(stride) {
             record::add_counters(&mut counters, slot);
@@ -307,12 +219,18 @@ impl Trace for WgpuBackend {
             while !overflowed.is_empty() {
                 cap = counts.iter().copied().max().unwrap_or(0).max(cap) * 2;
                 let again: Vec<Ray> = overflowed.iter().map(|&i| rays[i]).collect();
-                let Traced { hits: h2, records: r2, stride: s2, .. } =
-                    self.trace_with_cap(scene, &again, options, cap)?;
+                let mut h2 = vec![Hit::MISS; again.len()];
+                let r2 = self.trace_with_cap(scene, &again, options, cap, &mut h2)?.records;
+                let s2 = launch::record_stride(options, cap);
                 let (mut still, mut still_counts) = (Vec::new(), Vec::new());
                 for (k, &i) in overflowed.iter().enumerate() {
                     if !h2[k].same_as(&hits[i]) {
-                        return Err(device_error(format!("ray {i} found a different hit when traced again")));
+                        return Err(device_error(format!(
+                            "{}: ray {i} found a different hit when traced again ({:?}, then {:?})",
+                            options.method.name(),
+                            hits[i],
+                            h2[k]
+                        )));
                     }
                     let slot = &r2[k * s2..(k + 1) * s2];
                     match record::node_refs(slot, cap) {

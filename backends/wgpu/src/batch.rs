@@ -1,169 +1,269 @@
-//! One batch of rays on the device: upload, dispatch, read back.
+//! A stream of ray batches on the device: each batch is uploaded, dispatched and copied to its
+//! slot's read-back buffers in one submission, and up to `in_flight` batches are submitted before
+//! the oldest one is waited for, so that the device works on one batch while the host fills the
+//! next and empties the previous.
 
+use crate::config::{Dispatch, GpuConfig, CPU_ADAPTER_ROUNDS, MAX_PERSISTENT_ROUNDS};
 use crate::device::{device_error, Gpu};
 use crate::params::Params;
+use crate::workspace::{SceneBindings, Slot, Workspace, HIT_BYTES};
 use bytemuck::Pod;
+use raytrail_core::method::Method;
 use raytrail_core::{Error, Hit, Ray};
-use wgpu::util::DeviceExt;
+use std::collections::VecDeque;
+use std::sync::mpsc;
 
-/// What a batch returns.
-pub(crate) struct BatchOut {
-    pub hits: Vec<Hit>,
-    /// `records` words (empty when nothing is recorded).
+/// Everything a stream of batches shares: the kernel, what it binds and its parameters.
+pub(crate) struct Launch<'a> {
+    pub pipeline: &'a wgpu::ComputePipeline,
+    pub bind_layout: &'a wgpu::BindGroupLayout,
+    /// The bind-group cache key: a method binds the same scene buffers every time.
+    pub method: Method,
+    pub scene: SceneBindings<'a>,
+    /// Per-scene parameters; the batch fills in its own counts.
+    pub params: Params,
+    /// Rays per work item (1, or the packet width).
+    pub rays_per_item: usize,
+    pub config: GpuConfig,
+}
+
+/// What a stream of batches returns besides the hits.
+pub(crate) struct StreamOut {
+    /// `record_stride` words per ray, in ray order (empty when nothing is recorded).
     pub records: Vec<u32>,
-    /// GPU seconds from timestamp queries, when the adapter has them.
+    /// GPU seconds summed over the batches' passes, when every batch was timed.
     pub gpu_seconds: Option<f64>,
 }
 
-/// The buffers a kernel binds besides the batch's own.
-pub(crate) struct SceneBindings<'a> {
-    pub bvh: &'a wgpu::Buffer,
-    pub hash: &'a wgpu::Buffer,
-    pub kd: &'a wgpu::Buffer,
+/// Rays per batch for `launch`: the configured size within the device's binding and dispatch
+/// limits, a multiple of the rays per item.
+pub(crate) fn batch_rays(gpu: &Gpu, launch: &Launch<'_>) -> usize {
+    let l = &gpu.limits;
+    let stride = launch.params.record_stride.max(1) as usize;
+    let binding = (l.max_storage_buffer_binding_size.min(l.max_buffer_size) as usize).max(64);
+    let by_binding = (binding / 32).min(binding / (4 * stride));
+    let by_dispatch = l.max_compute_workgroups_per_dimension as usize * launch.config.workgroup_size as usize * 1024;
+    let per_item = launch.rays_per_item.max(1);
+    let n = launch.config.batch_rays.min(by_binding).min(by_dispatch).max(per_item);
+    n - n % per_item
 }
 
-fn storage_rw(gpu: &Gpu, label: &str, bytes: u64) -> wgpu::Buffer {
-    gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: bytes.max(16),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    })
+/// Rounds a persistent workgroup fetches at most on `gpu` (see [`CPU_ADAPTER_ROUNDS`]).
+fn persistent_rounds(gpu: &Gpu) -> usize {
+    if gpu.info.device_type == wgpu::DeviceType::Cpu {
+        CPU_ADAPTER_ROUNDS
+    } else {
+        MAX_PERSISTENT_ROUNDS
+    }
 }
 
-fn readback(gpu: &Gpu, bytes: u64) -> wgpu::Buffer {
-    gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: bytes.max(16),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
+/// The dispatch of `items` work items: workgroups in x and y, the grid's row width, and the rounds
+/// a persistent workgroup fetches at most (the workgroups cover the items within them).
+pub(crate) fn grid(gpu: &Gpu, launch: &Launch<'_>, items: usize) -> Result<Dispatched, Error> {
+    let wg = launch.config.workgroup_size as usize;
+    let rounds = persistent_rounds(gpu);
+    let groups = match launch.config.dispatch {
+        Dispatch::Grid => items.div_ceil(wg),
+        Dispatch::Persistent { workgroups } => {
+            (workgroups as usize).max(items.div_ceil(wg * rounds)).min(items.div_ceil(wg))
+        }
+    }
+    .max(1);
+    let max_x = gpu.limits.max_compute_workgroups_per_dimension as usize;
+    let x = groups.min(max_x);
+    let y = groups.div_ceil(x);
+    if y > max_x {
+        return Err(device_error(format!("{items} work items exceed one dispatch (batching failed)")));
+    }
+    Ok(Dispatched { x: x as u32, y: y as u32, row_width: (x * wg) as u32, rounds: rounds as u32 })
 }
 
-pub(crate) fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, count: usize) -> Result<Vec<T>, Error> {
-    let slice = buffer.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
+/// What [`grid`] decides.
+pub(crate) struct Dispatched {
+    pub x: u32,
+    pub y: u32,
+    pub row_width: u32,
+    pub rounds: u32,
+}
+
+impl Dispatched {
+    /// The batch's parameters: `base` with its ray count and the dispatch's figures.
+    pub fn params(&self, base: Params, rays: usize) -> Params {
+        Params { ray_count: rays as u32, row_width: self.row_width, persistent_rounds: self.rounds, ..base }
+    }
+}
+
+/// A submitted batch waiting to be read back.
+struct Pending {
+    slot: usize,
+    /// Its first ray in the stream, and its rays.
+    first: usize,
+    rays: usize,
+    submission: wgpu::SubmissionIndex,
+    /// One result per buffer mapped (hits, then records and timestamps where present).
+    mapped: Vec<mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>>,
+}
+
+/// Starts mapping `buffer`'s first `bytes` for reading; the receiver gets the outcome.
+fn map(buffer: &wgpu::Buffer, bytes: u64) -> mpsc::Receiver<Result<(), wgpu::BufferAsyncError>> {
+    let (tx, rx) = mpsc::channel();
+    buffer.slice(..bytes).map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
+    rx
+}
+
+/// Copies `buffer`'s first `out.len()` values into `out` (the buffer is mapped) and unmaps it.
+fn take<T: Pod>(buffer: &wgpu::Buffer, out: &mut [T]) -> Result<(), Error> {
+    let bytes = std::mem::size_of_val(out) as u64;
+    if bytes > 0 {
+        let view = buffer
+            .slice(..bytes)
+            .get_mapped_range()
+            .map_err(|e| device_error(format!("reading a mapped buffer: {e:?}")))?;
+        out.copy_from_slice(bytemuck::cast_slice(&view));
+    }
+    buffer.unmap();
+    Ok(())
+}
+
+/// Which timestamps a batch's pass writes.
+pub(crate) enum Stamps<'q> {
+    /// Its slot's two, around the pass (where the slot has queries).
+    Slot,
+    /// Into `queries`: index 0 before the pass if `begin`, index 1 after it if `end` (timestamps
+    /// around many passes).
+    Around { queries: &'q wgpu::QuerySet, begin: bool, end: bool },
+}
+
+/// Records one batch's pass in `enc` (the item counter zeroed first for persistent threads).
+pub(crate) fn encode(
+    gpu: &Gpu,
+    enc: &mut wgpu::CommandEncoder,
+    launch: &Launch<'_>,
+    slot: &mut Slot,
+    dims: (u32, u32),
+    stamps: Stamps<'_>,
+) {
+    if let Dispatch::Persistent { .. } = launch.config.dispatch {
+        enc.clear_buffer(&slot.counter, 0, None);
+    }
+    let bind = slot.bind_group(gpu, launch.bind_layout, launch.method, &launch.scene).clone();
+    let timestamp_writes = match stamps {
+        Stamps::Slot => slot.timer.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
+            query_set: &t.queries,
+            beginning_of_pass_write_index: Some(0),
+            end_of_pass_write_index: Some(1),
+        }),
+        Stamps::Around { queries, begin, end } => (begin || end).then_some(wgpu::ComputePassTimestampWrites {
+            query_set: queries,
+            beginning_of_pass_write_index: begin.then_some(0),
+            end_of_pass_write_index: end.then_some(1),
+        }),
+    };
+    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes });
+    pass.set_pipeline(launch.pipeline);
+    pass.set_bind_group(0, &bind, &[]);
+    pass.dispatch_workgroups(dims.0, dims.1, 1);
+}
+
+/// Traces `rays` in batches into `hits` (one per ray), keeping `in_flight` batches on the device.
+pub(crate) fn run(
+    gpu: &Gpu,
+    ws: &mut Workspace,
+    launch: &Launch<'_>,
+    rays: &[Ray],
+    hits: &mut [Hit],
+) -> Result<StreamOut, Error> {
+    let stride = launch.params.record_stride as usize;
+    let mut records = vec![0u32; rays.len() * stride];
+    let mut gpu_seconds = Some(0.0);
+    if rays.is_empty() {
+        return Ok(StreamOut { records, gpu_seconds });
+    }
+    let per_batch = batch_rays(gpu, launch);
+    let max_bytes = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+    let period = f64::from(gpu.queue.get_timestamp_period()) * 1e-9;
+    let mut pending: VecDeque<Pending> = VecDeque::new();
+    let mut finish = |p: Pending, hits: &mut [Hit], records: &mut [u32], ws: &mut Workspace| -> Result<(), Error> {
+        gpu.device
+            .poll(wgpu::PollType::Wait { submission_index: Some(p.submission), timeout: None })
+            .map_err(|e| device_error(format!("waiting for the device: {e}")))?;
+        for rx in &p.mapped {
+            rx.recv()
+                .map_err(|_| device_error("the read-back callback never ran"))?
+                .map_err(|e| device_error(format!("mapping a read-back buffer: {e}")))?;
+        }
+        let slot = ws.slot(gpu, p.slot, 0, 0, max_bytes);
+        take(&slot.hit_back, &mut hits[p.first..p.first + p.rays])?;
+        if stride > 0 {
+            take(&slot.record_back, &mut records[p.first * stride..(p.first + p.rays) * stride])?;
+        }
+        if let Some(t) = &slot.timer {
+            let mut stamps = [0u64; 2];
+            take(&t.back, &mut stamps)?;
+            gpu_seconds = gpu_seconds.map(|s| s + stamps[1].saturating_sub(stamps[0]) as f64 * period);
+        } else {
+            gpu_seconds = None;
+        }
+        Ok(())
+    };
+    gpu.checked("tracing a stream of batches", || -> Result<(), Error> {
+        for (b, chunk) in rays.chunks(per_batch).enumerate() {
+            let slot_index = b % launch.config.in_flight;
+            if pending.len() >= launch.config.in_flight {
+                if let Some(p) = pending.pop_front() {
+                    finish(p, hits, &mut records, ws)?;
+                }
+            }
+            let n = chunk.len();
+            let items = n.div_ceil(launch.rays_per_item);
+            let d = grid(gpu, launch, items)?;
+            let params = d.params(launch.params, n);
+            let slot = ws.slot(gpu, slot_index, n, n * stride, max_bytes);
+            gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&params));
+            gpu.queue.write_buffer(&slot.rays, 0, bytemuck::cast_slice(chunk));
+            let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
+            encode(gpu, &mut enc, launch, slot, (d.x, d.y), Stamps::Slot);
+            let hit_bytes = n as u64 * HIT_BYTES;
+            enc.copy_buffer_to_buffer(&slot.hits, 0, &slot.hit_back, 0, hit_bytes);
+            let record_bytes = (n * stride * 4) as u64;
+            if record_bytes > 0 {
+                enc.copy_buffer_to_buffer(&slot.records, 0, &slot.record_back, 0, record_bytes);
+            }
+            if let Some(t) = &slot.timer {
+                enc.resolve_query_set(&t.queries, 0..2, &t.resolve, 0);
+                enc.copy_buffer_to_buffer(&t.resolve, 0, &t.back, 0, 16);
+            }
+            let submission = gpu.queue.submit([enc.finish()]);
+            let mut mapped = vec![map(&slot.hit_back, hit_bytes)];
+            if record_bytes > 0 {
+                mapped.push(map(&slot.record_back, record_bytes));
+            }
+            if let Some(t) = &slot.timer {
+                mapped.push(map(&t.back, 16));
+            }
+            pending.push_back(Pending { slot: slot_index, first: b * per_batch, rays: n, submission, mapped });
+        }
+        while let Some(p) = pending.pop_front() {
+            finish(p, hits, &mut records, ws)?;
+        }
+        Ok(())
+    })??;
+    Ok(StreamOut { records, gpu_seconds })
+}
+
+/// Reads `count` values of `T` from the start of the read-back `buffer` (for one-off reads such as
+/// the numerics probe's and the stream method's).
+pub(crate) fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, count: usize) -> Result<Vec<T>, Error> {
+    let rx = map(buffer, (count * std::mem::size_of::<T>()).max(4) as u64);
     gpu.device
         .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
         .map_err(|e| device_error(format!("waiting for the device: {e}")))?;
     rx.recv()
         .map_err(|_| device_error("the read-back callback never ran"))?
         .map_err(|e| device_error(format!("mapping a read-back buffer: {e}")))?;
-    let view = slice.get_mapped_range().map_err(|e| device_error(format!("reading a mapped buffer: {e:?}")))?;
-    let all: &[T] = bytemuck::cast_slice(&view);
-    let out = all[..count].to_vec();
-    drop(view);
-    buffer.unmap();
+    let mut out = vec![T::zeroed(); count];
+    take(buffer, &mut out)?;
     Ok(out)
-}
-
-/// Runs `pipeline` over `rays` with `invocations` invocations (one per ray, or one per packet).
-pub(crate) fn run(
-    gpu: &Gpu,
-    pipeline: &wgpu::ComputePipeline,
-    bind_layout: &wgpu::BindGroupLayout,
-    scene: &SceneBindings<'_>,
-    mut params: Params,
-    rays: &[Ray],
-    invocations: usize,
-) -> Result<BatchOut, Error> {
-    const WORKGROUP: usize = 64;
-    let groups = invocations.div_ceil(WORKGROUP).max(1);
-    let max_x = gpu.limits.max_compute_workgroups_per_dimension as usize;
-    let x = groups.min(max_x);
-    let y = groups.div_ceil(x);
-    if y > max_x {
-        return Err(device_error(format!("{invocations} invocations exceed one dispatch (batching failed)")));
-    }
-    params.ray_count = rays.len() as u32;
-    params.row_width = (x * WORKGROUP) as u32;
-    let n = rays.len();
-    let record_words = n * params.record_stride as usize;
-    let d = &gpu.device;
-    gpu.checked("tracing a batch", || -> Result<BatchOut, Error> {
-        let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let ray_bytes: &[u8] = if rays.is_empty() { &[0u8; 32] } else { bytemuck::cast_slice(rays) };
-        let ray_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("rays"),
-            contents: ray_bytes,
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let hit_bytes = (n * 16) as u64;
-        let hit_buf = storage_rw(gpu, "hits", hit_bytes);
-        let rec_bytes = (record_words * 4) as u64;
-        let rec_buf = storage_rw(gpu, "records", rec_bytes);
-        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raytrail batch"),
-            layout: bind_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: ray_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: hit_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: scene.bvh.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: scene.hash.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: scene.kd.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: rec_buf.as_entire_binding() },
-            ],
-        });
-        let queries = gpu.timestamps.then(|| {
-            d.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("trace time"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2,
-            })
-        });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("trace") });
-        {
-            let timestamp_writes = queries.as_ref().map(|q| wgpu::ComputePassTimestampWrites {
-                query_set: q,
-                beginning_of_pass_write_index: Some(0),
-                end_of_pass_write_index: Some(1),
-            });
-            let mut pass =
-                enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(x as u32, y as u32, 1);
-        }
-        let hit_back = readback(gpu, hit_bytes);
-        enc.copy_buffer_to_buffer(&hit_buf, 0, &hit_back, 0, hit_bytes.max(16));
-        let rec_back = (record_words > 0).then(|| {
-            let b = readback(gpu, rec_bytes);
-            enc.copy_buffer_to_buffer(&rec_buf, 0, &b, 0, rec_bytes);
-            b
-        });
-        let time_back = queries.as_ref().map(|q| {
-            let resolve = d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamps"),
-                size: 16,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            enc.resolve_query_set(q, 0..2, &resolve, 0);
-            let back = readback(gpu, 16);
-            enc.copy_buffer_to_buffer(&resolve, 0, &back, 0, 16);
-            back
-        });
-        gpu.queue.submit([enc.finish()]);
-        let hits = read::<Hit>(gpu, &hit_back, n)?;
-        let records = match &rec_back {
-            Some(b) => read::<u32>(gpu, b, record_words)?,
-            None => Vec::new(),
-        };
-        let gpu_seconds = match &time_back {
-            Some(b) => {
-                let t = read::<u64>(gpu, b, 2)?;
-                Some(t[1].saturating_sub(t[0]) as f64 * f64::from(gpu.queue.get_timestamp_period()) * 1e-9)
-            }
-            None => None,
-        };
-        Ok(BatchOut { hits, records, gpu_seconds })
-    })?
 }

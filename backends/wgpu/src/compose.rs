@@ -6,6 +6,7 @@
 //! - by override constants, for switches the compiler folds away: any hit, recording, the
 //!   disjoint-interval mask.
 
+use crate::config::Dispatch;
 use raytrail_core::intersect::{FAR_PAD, RELIABLE_LIMIT, SLACK_SCALE};
 use raytrail_core::kd::traverse::{PACKET_WIDTH, SHORT_STACK_MAX};
 use raytrail_core::key::KeyWidth;
@@ -45,6 +46,8 @@ const KD_STACK: Part = part!(KD_STACK);
 const KD_RESTART: Part = part!(KD_RESTART);
 const KD_PACKET: Part = part!(KD_PACKET);
 const ENTRY: Part = part!(ENTRY);
+const DISPATCH_GRID: Part = part!(DISPATCH_GRID);
+const DISPATCH_PERSISTENT: Part = part!(DISPATCH_PERSISTENT);
 const WIDE: Part = part!(WIDE);
 
 /// Everything that selects a kernel.
@@ -60,13 +63,37 @@ pub struct Variant {
     pub query: Query,
     /// What is recorded.
     pub record: Record,
+    /// How invocations get their rays (grid or persistent threads).
+    pub dispatch: DispatchKind,
+    /// Invocations per workgroup (the `WORKGROUP_SIZE` override).
+    pub workgroup_size: u32,
+}
+
+/// The dispatch file of a kernel: what [`Dispatch`] compiles to (the number of persistent
+/// workgroups is the host's choice, not the kernel's).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum DispatchKind {
+    /// `dispatch_grid.wgsl`.
+    #[default]
+    Grid,
+    /// `dispatch_persistent.wgsl`.
+    Persistent,
+}
+
+impl From<Dispatch> for DispatchKind {
+    fn from(d: Dispatch) -> Self {
+        match d {
+            Dispatch::Grid => DispatchKind::Grid,
+            Dispatch::Persistent { .. } => DispatchKind::Persistent,
+        }
+    }
 }
 
 impl Variant {
     /// The variant's name, for labels and messages.
     pub fn label(&self) -> String {
         format!(
-            "{}/{}/{}/{}/{:?}",
+            "{}/{}/{}/{}/{:?}/{:?}/{}",
             self.method.name(),
             if self.keys == KeyWidth::W64 { "k64" } else { "k32" },
             match self.triangle {
@@ -74,12 +101,33 @@ impl Variant {
                 TriangleTestKind::MollerTrumbore => "moller-trumbore",
             },
             self.query.name(),
-            self.record
+            self.record,
+            self.dispatch,
+            self.workgroup_size
         )
     }
 
     /// The WGSL files of this kernel, in order; [`Error::Unsupported`] for a method without one.
     pub fn parts(&self) -> Result<Vec<Part>, Error> {
+        let mut parts = self.method_parts()?;
+        // The stream method's intersection kernel has its own entry point.
+        if let Method::Stream(_) = self.method {
+            return Ok(parts);
+        }
+        // The packet kernel defines its own work items (one packet each).
+        if self.method != Method::Kd(KdMethod::Packet) {
+            parts.push(ENTRY);
+        }
+        parts.push(match self.dispatch {
+            DispatchKind::Grid => DISPATCH_GRID,
+            DispatchKind::Persistent => DISPATCH_PERSISTENT,
+        });
+        Ok(parts)
+    }
+
+    /// The files up to and including the method's, without work items or a dispatch file (the
+    /// stream method's intersection kernel adds its own entry point to the wide method's files).
+    pub(crate) fn method_parts(&self) -> Result<Vec<Part>, Error> {
         let triangle = match self.triangle {
             TriangleTestKind::Watertight => WATERTIGHT,
             TriangleTestKind::MollerTrumbore => MOLLER_TRUMBORE,
@@ -105,10 +153,6 @@ impl Variant {
             other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
         };
         parts.extend_from_slice(method);
-        // A packet kernel has its own entry point: one invocation per packet of rays.
-        if self.method != Method::Kd(KdMethod::Packet) {
-            parts.push(ENTRY);
-        }
         Ok(parts)
     }
 
@@ -125,8 +169,17 @@ impl Variant {
         Ok(s)
     }
 
-    /// Values of the override constants.
+    /// Values of the override constants: the method's, and the dispatch's workgroup size.
     pub fn overrides(&self) -> Vec<(&'static str, f64)> {
+        let mut o = self.method_overrides();
+        if !matches!(self.method, Method::Stream(_)) {
+            o.push(("WORKGROUP_SIZE", f64::from(self.workgroup_size)));
+        }
+        o
+    }
+
+    /// Values of the override constants the method's files declare.
+    pub(crate) fn method_overrides(&self) -> Vec<(&'static str, f64)> {
         let record = match self.record {
             Record::Nothing => 0.0,
             Record::Counters => 1.0,
@@ -172,17 +225,22 @@ pub(crate) fn constants_header(method: Method) -> String {
     )
 }
 
-/// Every variant a scene with keys of width `keys` can ask for.
+/// Every variant a scene with keys of width `keys` can ask for, with the default workgroup size
+/// and both dispatch files.
 pub fn all_variants(keys: KeyWidth) -> impl Iterator<Item = Variant> {
     Method::ALL.into_iter().flat_map(move |method| {
         [TriangleTestKind::Watertight, TriangleTestKind::MollerTrumbore].into_iter().flat_map(move |triangle| {
             [Query::Closest, Query::Any].into_iter().flat_map(move |query| {
-                [Record::Nothing, Record::Counters, Record::Enumerations].into_iter().map(move |record| Variant {
-                    method,
-                    keys,
-                    triangle,
-                    query,
-                    record,
+                [Record::Nothing, Record::Counters, Record::Enumerations].into_iter().flat_map(move |record| {
+                    [DispatchKind::Grid, DispatchKind::Persistent].into_iter().map(move |dispatch| Variant {
+                        method,
+                        keys,
+                        triangle,
+                        query,
+                        record,
+                        dispatch,
+                        workgroup_size: crate::GpuConfig::default().workgroup_size,
+                    })
                 })
             })
         })
@@ -198,9 +256,17 @@ mod tests {
         let src = v.source().expect("every method has a kernel");
         let module = naga::front::wgsl::parse_str(&src).map_err(|e| e.emit_to_string(&src))?;
         let caps = naga::valid::Capabilities::FLOAT64;
-        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
+        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
             .validate(&module)
             .map_err(|e| e.emit_to_string(&src))?;
+        // Every override the host sets exists, and the module validates with them applied.
+        let mut constants = naga::back::PipelineConstants::default();
+        for (name, value) in v.overrides() {
+            constants.insert(name.to_string(), value);
+        }
+        let stage = Some((naga::ShaderStage::Compute, "main"));
+        naga::back::pipeline_constants::process_overrides(&module, &info, stage, &constants)
+            .map_err(|e| format!("overrides: {e}"))?;
         Ok(())
     }
 
@@ -222,7 +288,7 @@ mod tests {
             failures.len(),
             failures.join("\n")
         );
-        assert_eq!(n, 2 * Method::ALL.len() * 2 * 2 * 3);
+        assert_eq!(n, 2 * Method::ALL.len() * 2 * 2 * 3 * 2);
     }
 
     #[test]

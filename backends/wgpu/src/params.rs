@@ -22,7 +22,8 @@ pub(crate) struct Params {
     pub kd_prims: u32,
     pub kd_tris: u32,
     pub wide_root_count: u32,
-    pub pad: u32,
+    /// Persistent threads: the most rounds a workgroup fetches.
+    pub persistent_rounds: u32,
     pub kd_lo: [f32; 4],
     pub kd_hi: [f32; 4],
 }

@@ -54,9 +54,10 @@ fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntr
 impl Pipelines {
     pub fn new(gpu: &Gpu) -> Pipelines {
         // shaders/prelude.wgsl: parameters, rays (read), hits (write), three scene buffers (read),
-        // records (write).
+        // records (write); shaders/dispatch_persistent.wgsl: the item counter (read and write).
         let (read, write) = (Some(true), Some(false));
-        let (bind_layout, layout) = buffer_layout(gpu, "raytrail", &[None, read, write, read, read, read, write]);
+        let (bind_layout, layout) =
+            buffer_layout(gpu, "raytrail", &[None, read, write, read, read, read, write, write]);
         Pipelines { bind_layout, layout, compiled: Mutex::new(HashMap::new()) }
     }
 

@@ -2,12 +2,13 @@
 //! once, and nothing it was not.
 
 use crate::device::{device_error, Gpu};
+use crate::workspace::Workspace;
 use raytrail_core::bvh2::BinaryLayout;
 use raytrail_core::method::{Bvh2Method, WideMethod};
 use raytrail_core::prepared::{BuiltHash, PreparedScene};
 use raytrail_core::wide::WideBvh;
 use raytrail_core::Error;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard};
 use wgpu::util::DeviceExt;
 
 /// A BVH2 layout on the device: internal nodes, then the leaf array.
@@ -49,6 +50,9 @@ pub struct WgpuScene {
     pub(crate) levels: Option<KdBuffer>,
     /// A small buffer bound where a kernel's unused bindings would be.
     pub(crate) empty: wgpu::Buffer,
+    /// Batch buffers kept between traces (every method but the stream method, whose stage arrays
+    /// are sized by each call's rays).
+    workspace: Mutex<Workspace>,
 }
 
 fn storage(gpu: &Gpu, label: &str, words: &[u32]) -> Result<wgpu::Buffer, Error> {
@@ -167,7 +171,21 @@ impl WgpuScene {
             wide4_naive,
             levels,
             empty,
+            workspace: Mutex::new(Workspace::default()),
         })
+    }
+
+    /// Device buffers (and timestamp query sets) the scene's traces have created so far: a trace
+    /// no larger than an earlier one creates none.
+    pub fn buffers_created(&self) -> u64 {
+        self.workspace.lock().map_or(0, |w| w.created())
+    }
+
+    /// The batch buffers, for one trace at a time.
+    pub(crate) fn workspace(&self) -> Result<MutexGuard<'_, Workspace>, Error> {
+        self.workspace
+            .lock()
+            .map_err(|_| device_error("the scene's batch buffers were poisoned by a panic in another thread"))
     }
 
     /// The layout buffer `method` reads.

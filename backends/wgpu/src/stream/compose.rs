@@ -81,6 +81,9 @@ impl StreamKernel {
             triangle: options.triangle_test,
             query: options.query,
             record,
+            // Its own entry point: these two are not used.
+            dispatch: Default::default(),
+            workgroup_size: crate::GpuConfig::default().workgroup_size,
         })
     }
 
@@ -123,11 +126,9 @@ impl StreamKernel {
     /// The files of the kernel, in order.
     pub(crate) fn parts(&self) -> Result<Vec<Part>, Error> {
         let mut parts = match self {
-            // The wide methods' files without their entry point (the stream file has its own).
+            // The wide methods' files without work items or dispatch (the stream file has its own).
             StreamKernel::Intersect(v) => {
-                let mut p = Variant { method: Method::Wide(raytrail_core::method::WideMethod::Bvh8), ..*v }.parts()?;
-                p.pop();
-                p
+                Variant { method: Method::Wide(raytrail_core::method::WideMethod::Bvh8), ..*v }.method_parts()?
             }
             _ => vec![part!(PRELUDE), part!(NUMERICS), part!(BOX)],
         };
@@ -158,7 +159,7 @@ impl StreamKernel {
         match self {
             StreamKernel::Intersect(v) => {
                 let record = if v.record == Record::Nothing { Record::Nothing } else { Record::Counters };
-                Variant { record, ..*v }.overrides()
+                Variant { record, ..*v }.method_overrides()
             }
             _ => Vec::new(),
         }

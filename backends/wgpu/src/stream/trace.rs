@@ -101,7 +101,14 @@ pub(crate) fn trace(
     options: &TraceOptions,
     hits: &mut [Hit],
 ) -> Result<Report, Error> {
-    gpu.checked("tracing with the stream method", || trace_checked(gpu, kernels, scene, method, rays, options, hits))?
+    let start = std::time::Instant::now();
+    let mut report = gpu.checked("tracing with the stream method", || {
+        trace_checked(gpu, kernels, scene, method, rays, options, hits)
+    })??;
+    // End to end, the plan's read-backs and the host's share included; the kernels' own time is
+    // the stages' timestamps.
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok(report)
 }
 
 fn trace_checked(
@@ -135,7 +142,7 @@ fn trace_checked(
     let back = run.read(&[(&hit_buffer, 0, words(4)?), (&record_buffer, 0, words(stride)?)])?;
     run.next_stage(3)?;
     hits.copy_from_slice(bytemuck::cast_slice(&back[0]));
-    let (seconds, _) = run.seconds();
+    let (seconds, timed) = run.seconds();
     let stats = StreamStats {
         packets: p.packets as usize,
         active_frustums: l.active as usize,
@@ -154,7 +161,9 @@ fn trace_checked(
             intersection: seconds[3],
         },
     };
-    let mut report = Report::new(rays.len(), seconds.iter().sum());
+    let mut report = Report::new(rays.len(), 0.0);
+    report.kernel_seconds = timed.then(|| seconds.iter().sum());
+    report.transfer_bytes = crate::backend::bytes_moved(rays.len(), stride);
     if options.record != Record::Nothing {
         let mut counters = Counters { rays: rays.len() as u64, ..Counters::default() };
         for slot in back[1].chunks(stride) {

@@ -1,0 +1,135 @@
+//! What a trace of one method binds and sets: the scene's buffers for the method, the per-scene
+//! parameters, and the kd-packet kernel's arrangement of rays into packets.
+
+use crate::batch::Launch;
+use crate::compose::Variant;
+use crate::config::GpuConfig;
+use crate::params::Params;
+use crate::record;
+use crate::scene::WgpuScene;
+use crate::workspace::SceneBindings;
+use raytrail_core::bvh2::NodeRef;
+use raytrail_core::kd::traverse::packets::{packet_slots, PADDING};
+use raytrail_core::kd::traverse::PACKET_WIDTH;
+use raytrail_core::method::{KdMethod, Method};
+use raytrail_core::trace::{Record, TraceOptions};
+use raytrail_core::wide::WideChild;
+use raytrail_core::{Error, Ray};
+
+/// The kernel variant for `options` on `scene` under `config`.
+pub(crate) fn variant(scene: &WgpuScene, options: &TraceOptions, config: &GpuConfig) -> Variant {
+    Variant {
+        method: options.method,
+        keys: scene.prepared.key_width(),
+        triangle: options.triangle_test,
+        query: options.query,
+        record: options.record,
+        dispatch: config.dispatch.into(),
+        workgroup_size: config.workgroup_size,
+    }
+}
+
+/// Record words per ray for `options` with room for `cap` node events.
+pub(crate) fn record_stride(options: &TraceOptions, cap: usize) -> usize {
+    match options.record {
+        Record::Nothing => 0,
+        Record::Counters => record::stride(0),
+        Record::Enumerations => record::stride(cap),
+    }
+}
+
+/// The launch of `pipeline` for `options` on `scene`, recording up to `cap` node events per ray.
+pub(crate) fn launch<'a>(
+    scene: &'a WgpuScene,
+    options: &TraceOptions,
+    cap: usize,
+    pipeline: &'a wgpu::ComputePipeline,
+    bind_layout: &'a wgpu::BindGroupLayout,
+    config: GpuConfig,
+) -> Result<Launch<'a>, Error> {
+    let p = &scene.prepared;
+    let stride = record_stride(options, cap);
+    let mut params = Params { record_stride: stride as u32, record_cap: cap as u32, ..Params::default() };
+    let scene_bindings = match options.method {
+        Method::Bvh2(m) => {
+            let root = p.root(m)?;
+            let layout =
+                scene.layout_for(m).ok_or(Error::NotPrepared { method: m.name(), missing: "its BVH2 layout" })?;
+            params.root = root.node.0;
+            params.max_steps = root.max_steps;
+            params.scene_scale = root.scene_scale;
+            params.leaf_base = layout.leaf_base;
+            let hash = match scene.hash_for(m) {
+                Some(h) => {
+                    params.d_mask = h.d_mask;
+                    params.h = h.h;
+                    &h.buffer
+                }
+                None if m.needs_hash() => {
+                    return Err(Error::NotPrepared { method: m.name(), missing: "the hash tables" })
+                }
+                None => &scene.empty,
+            };
+            SceneBindings { bvh: &layout.buffer, hash, kd: &scene.empty }
+        }
+        Method::Kd(_) => {
+            let root = p.kd_root()?;
+            let kd = scene.kd.as_ref().ok_or(Error::NotPrepared { method: "kd", missing: "the kd-tree" })?;
+            params.max_steps = root.max_steps;
+            params.scene_scale = root.scene_scale;
+            params.short_stack = root.short_stack as u32;
+            params.kd_prims = kd.prims;
+            params.kd_tris = kd.tris;
+            params.kd_lo = [root.lo.x, root.lo.y, root.lo.z, 0.0];
+            params.kd_hi = [root.hi.x, root.hi.y, root.hi.z, 0.0];
+            SceneBindings { bvh: &scene.empty, hash: &scene.empty, kd: &kd.buffer }
+        }
+        Method::Wide(m) => {
+            let root = p.wide_root(m)?;
+            let tree = scene.wide_for(m).ok_or(Error::NotPrepared { method: m.name(), missing: "its wide tree" })?;
+            params.max_steps = root.max_steps;
+            params.scene_scale = root.scene_scale;
+            params.kd_prims = tree.prims;
+            params.kd_tris = tree.tris;
+            (params.root, params.wide_root_count) = match root.root {
+                WideChild::Node(n) => (n, 0),
+                WideChild::Leaf { first, count } => (NodeRef::leaf(first).0, count),
+            };
+            SceneBindings { bvh: &scene.empty, hash: &scene.empty, kd: &tree.buffer }
+        }
+        other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
+    };
+    let rays_per_item = if options.method == Method::Kd(KdMethod::Packet) { PACKET_WIDTH } else { 1 };
+    Ok(Launch { pipeline, bind_layout, method: options.method, scene: scene_bindings, params, rays_per_item, config })
+}
+
+/// The kd-packet kernel's rays, grouped as the core groups them (every backend alike): slot `s`
+/// of the result holds ray `order[s]`, padding as untraceable rays, so that packet `p` is slots
+/// `PACKET_WIDTH * p ..`. `None` for every other method.
+pub(crate) struct Arranged {
+    pub order: Vec<u32>,
+    pub rays: Vec<Ray>,
+}
+
+impl Arranged {
+    /// The arrangement of `rays` for `method`, if it needs one.
+    pub fn of(method: Method, rays: &[Ray]) -> Option<Arranged> {
+        if method != Method::Kd(KdMethod::Packet) {
+            return None;
+        }
+        let order = packet_slots(rays);
+        let pad = Ray { origin: [f32::NAN; 3], tmin: 0.0, dir: [f32::NAN; 3], tmax: 0.0 };
+        let arranged = order.iter().map(|&i| if i == PADDING { pad } else { rays[i as usize] }).collect();
+        Some(Arranged { order, rays: arranged })
+    }
+
+    /// Puts per-slot values (`stride` each) back in ray order: `out[order[s]] = slots[s]`.
+    pub fn restore<T: Copy>(&self, slots: &[T], stride: usize, out: &mut [T]) {
+        for (s, &i) in self.order.iter().enumerate() {
+            if i != PADDING {
+                let (dst, src) = (i as usize * stride, s * stride);
+                out[dst..dst + stride].copy_from_slice(&slots[src..src + stride]);
+            }
+        }
+    }
+}

@@ -1,0 +1,160 @@
+//! Per-scene device buffers kept between trace calls: a ring of batch slots, each with its ray,
+//! hit, record and read-back buffers and its bind groups, grown when a batch needs more and
+//! otherwise reused, so that tracing again allocates nothing.
+
+use crate::device::Gpu;
+use crate::params::Params;
+use raytrail_core::method::Method;
+use std::collections::HashMap;
+
+/// Bytes of one ray and one hit on the device.
+pub(crate) const RAY_BYTES: u64 = 32;
+pub(crate) const HIT_BYTES: u64 = 16;
+
+/// One batch's buffers. A slot is reused only after its previous batch has been read back.
+pub(crate) struct Slot {
+    pub uniform: wgpu::Buffer,
+    pub rays: wgpu::Buffer,
+    pub hits: wgpu::Buffer,
+    pub records: wgpu::Buffer,
+    /// The persistent kernels' item counter, zeroed before every dispatch.
+    pub counter: wgpu::Buffer,
+    pub hit_back: wgpu::Buffer,
+    pub record_back: wgpu::Buffer,
+    /// Two timestamps around the batch's pass, resolved and read back with the hits.
+    pub timer: Option<Timer>,
+    /// Rays the buffers hold.
+    pub ray_capacity: usize,
+    /// Record words the buffers hold.
+    pub record_capacity: usize,
+    /// Bind groups by method (a method binds the same scene buffers every time).
+    binds: HashMap<Method, wgpu::BindGroup>,
+}
+
+/// A slot's timestamp queries.
+pub(crate) struct Timer {
+    pub queries: wgpu::QuerySet,
+    pub resolve: wgpu::Buffer,
+    pub back: wgpu::Buffer,
+}
+
+/// The scene buffers a kernel binds besides the slot's own.
+pub(crate) struct SceneBindings<'a> {
+    pub bvh: &'a wgpu::Buffer,
+    pub hash: &'a wgpu::Buffer,
+    pub kd: &'a wgpu::Buffer,
+}
+
+/// The ring of slots of one scene, and how many buffers it has ever created.
+#[derive(Default)]
+pub(crate) struct Workspace {
+    slots: Vec<Slot>,
+    created: u64,
+}
+
+/// Capacity rounded up so that slowly growing batches do not reallocate every call.
+fn grown(needed: usize) -> usize {
+    needed.max(1).next_power_of_two()
+}
+
+impl Workspace {
+    /// Buffers (and query sets) created since the scene was uploaded.
+    pub fn created(&self) -> u64 {
+        self.created
+    }
+
+    /// Slot `i`, with room for `rays` rays and `record_words` record words; made or grown as
+    /// needed. `max_bytes` is the device's largest binding.
+    pub fn slot(&mut self, gpu: &Gpu, i: usize, rays: usize, record_words: usize, max_bytes: u64) -> &mut Slot {
+        while self.slots.len() <= i {
+            let slot = self.make(gpu, 0, 0, max_bytes);
+            self.slots.push(slot);
+        }
+        let s = &self.slots[i];
+        if s.ray_capacity < rays || s.record_capacity < record_words {
+            let (r, w) = (s.ray_capacity.max(rays), s.record_capacity.max(record_words));
+            self.slots[i] = self.make(gpu, r, w, max_bytes);
+        }
+        &mut self.slots[i]
+    }
+
+    /// A slot for `rays` rays and `record_words` words, capacities rounded up within `max_bytes`.
+    fn make(&mut self, gpu: &Gpu, rays: usize, record_words: usize, max_bytes: u64) -> Slot {
+        let cap = |n: usize, unit: u64| (grown(n) as u64 * unit).min(max_bytes.max(unit * n as u64)).max(16);
+        let ray_bytes = cap(rays, RAY_BYTES);
+        let hit_bytes = cap(rays, HIT_BYTES);
+        let record_bytes = cap(record_words, 4);
+        let ray_capacity = ((ray_bytes / RAY_BYTES) as usize).min((hit_bytes / HIT_BYTES) as usize);
+        let record_capacity = (record_bytes / 4) as usize;
+        use wgpu::BufferUsages as U;
+        let uniform = self.buffer(gpu, "params", std::mem::size_of::<Params>() as u64, U::UNIFORM | U::COPY_DST);
+        let rays_buf = self.buffer(gpu, "rays", ray_bytes, U::STORAGE | U::COPY_DST);
+        let hits = self.buffer(gpu, "hits", hit_bytes, U::STORAGE | U::COPY_SRC | U::COPY_DST);
+        let records = self.buffer(gpu, "records", record_bytes, U::STORAGE | U::COPY_SRC);
+        let counter = self.buffer(gpu, "item counter", 16, U::STORAGE | U::COPY_DST);
+        let hit_back = self.buffer(gpu, "hits read-back", hit_bytes, U::MAP_READ | U::COPY_DST);
+        let record_back = self.buffer(gpu, "records read-back", record_bytes, U::MAP_READ | U::COPY_DST);
+        let timer = gpu.timestamps.then(|| {
+            self.created += 1;
+            Timer {
+                queries: gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("batch time"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2,
+                }),
+                resolve: self.buffer(gpu, "timestamps", 16, U::QUERY_RESOLVE | U::COPY_SRC),
+                back: self.buffer(gpu, "timestamps read-back", 16, U::MAP_READ | U::COPY_DST),
+            }
+        });
+        Slot {
+            uniform,
+            rays: rays_buf,
+            hits,
+            records,
+            counter,
+            hit_back,
+            record_back,
+            timer,
+            ray_capacity,
+            record_capacity,
+            binds: HashMap::new(),
+        }
+    }
+
+    fn buffer(&mut self, gpu: &Gpu, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.created += 1;
+        gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+    }
+}
+
+impl Slot {
+    /// The bind group of `method` over this slot's buffers and `scene`'s, made on first use.
+    pub fn bind_group(
+        &mut self,
+        gpu: &Gpu,
+        layout: &wgpu::BindGroupLayout,
+        method: Method,
+        scene: &SceneBindings<'_>,
+    ) -> &wgpu::BindGroup {
+        let Slot { uniform, rays, hits, records, counter, binds, .. } = self;
+        binds.entry(method).or_insert_with(|| {
+            fn e(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+                wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
+            }
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("raytrail batch"),
+                layout,
+                entries: &[
+                    e(0, uniform),
+                    e(1, rays),
+                    e(2, hits),
+                    e(3, scene.bvh),
+                    e(4, scene.hash),
+                    e(5, scene.kd),
+                    e(6, records),
+                    e(7, counter),
+                ],
+            })
+        })
+    }
+}
