@@ -106,12 +106,15 @@ pub struct Report {
     pub enumerations: Option<Vec<Vec<u32>>>,
     /// A stream method's working figures and stage times (stream methods only, always).
     pub stream: Option<StreamStats>,
+    /// Rays refused: answered [`Hit::REFUSED`] because no method can answer them reliably
+    /// ([`PreparedScene::frame_rays`]). Never counted as misses.
+    pub refused: usize,
 }
 
 impl Report {
     /// A report of `rays` rays traced in `seconds`, recording nothing.
     pub fn new(rays: usize, seconds: f64) -> Self {
-        Self { rays, seconds, counters: None, enumerations: None, stream: None }
+        Self { rays, seconds, counters: None, enumerations: None, stream: None, refused: 0 }
     }
 
     /// Millions of rays per second.
@@ -132,6 +135,23 @@ pub fn check_buffers(rays: &[Ray], hits: &[Hit]) -> Result<(), Error> {
     } else {
         Err(Error::BufferMismatch { rays: rays.len(), hits: hits.len() })
     }
+}
+
+/// Traces a batch in `scene`'s frame ([`PreparedScene::frame_rays`]): checks the buffers, hands
+/// the framed rays to `trace`, puts the hits back in the caller's frame and counts the refused
+/// rays in the report. Every backend's [`Trace::trace`] goes through it, so all of them scale,
+/// move and refuse rays alike.
+pub fn trace_framed(
+    scene: &PreparedScene,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    trace: impl FnOnce(&[Ray], &mut [Hit]) -> Result<Report, Error>,
+) -> Result<Report, Error> {
+    check_buffers(rays, hits)?;
+    let framed = scene.frame_rays(rays);
+    let mut report = trace(framed.rays(), hits)?;
+    report.refused = framed.finish(hits);
+    Ok(report)
 }
 
 /// A backend: prepares a scene once, then traces batches of rays into hit buffers. Backends are
