@@ -36,13 +36,13 @@ mod tests {
 
     #[test]
     fn values_scale_exactly() {
-        assert_eq!(to_int(1.0), Some(BigInt::from(1) << 149));
-        assert_eq!(to_int(-0.5), Some(-(BigInt::from(1) << 148)));
+        assert_eq!(to_int(1.0), Some(BigInt::from(1) << 149usize));
+        assert_eq!(to_int(-0.5), Some(-(BigInt::from(1) << 148usize)));
         assert_eq!(to_int(f32::from_bits(1)), Some(BigInt::from(1)));
         assert_eq!(to_int(0.0), Some(BigInt::from(0)));
         assert_eq!(to_int(-0.0), Some(BigInt::from(0)));
         assert_eq!(to_int(f32::NAN), None);
         let max = to_int(f32::MAX).unwrap();
-        assert_eq!(max, BigInt::from((1u64 << 24) - 1) << (104 + 149));
+        assert_eq!(max, BigInt::from((1u64 << 24) - 1) << (104usize + 149));
     }
 }

@@ -153,7 +153,8 @@ mod tests {
         assert!(matches!(filter(&down(0.2, 0.2), &tri), Filtered::Hit { lo, hi } if lo <= 3.0 && hi >= 3.0));
         assert_eq!(filter(&down(0.9, 0.9), &tri), Filtered::Miss);
         assert!(matches!(filter(&down(0.5, 0.5), &tri), Filtered::Unsure { .. }));
-        assert!((margin(&down(0.25, 0.5), &tri).unwrap() - 0.25).abs() < 1e-12);
+        // Nearest edge: the hypotenuse, at (1 - 0.75) / sqrt(2).
+        assert!((margin(&down(0.25, 0.5), &tri).unwrap() - 0.25 / 2f64.sqrt()).abs() < 1e-12);
         assert!(margin(&down(2.0, 0.5), &tri).unwrap() < 0.0);
     }
 }
