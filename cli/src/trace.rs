@@ -53,7 +53,18 @@ pub fn main(a: TraceArgs) -> Outcome {
     let out = &a.out;
     npy::write_hits(out, &hits).map_err(|e| e.to_string())?;
     let n_hit = hits.iter().filter(|h| h.is_hit()).count();
-    println!("{} rays, {} hits, {:.2} Mrays/s ({method}), written to {out}", rays.len(), n_hit, report.mrays_per_s());
+    println!(
+        "{} rays, {} hits, {} refused, {:.2} Mrays/s ({method}), written to {out}",
+        rays.len(),
+        n_hit,
+        report.refused,
+        report.mrays_per_s()
+    );
+    if report.refused > 0 {
+        // Refused rays are not misses: they are outside the supported range (docs/NUMERICS-RANGE.md)
+        // and marked in the hits file with t = NaN, prim = 0xFFFFFFFE.
+        println!("  {} rays refused: outside the supported numeric range (docs/NUMERICS-RANGE.md)", report.refused);
+    }
     Ok(0)
 }
 

@@ -14,11 +14,13 @@
 #![warn(missing_docs)]
 
 pub mod check;
+pub mod exact;
 pub mod paths;
 pub mod rays;
 pub mod reference;
 pub mod rng;
 pub mod scenes;
+pub mod stress;
 pub mod suite;
 
 pub use check::{check_ray_set, compare, Context, Difference, Mismatch};

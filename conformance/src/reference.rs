@@ -152,6 +152,19 @@ impl Trace for SerialBackend {
         opts: &TraceOptions,
         hits: &mut [Hit],
     ) -> Result<Report, Error> {
+        raytrail_core::trace::trace_framed(scene, rays, hits, |rays, hits| self.trace_in_frame(scene, rays, opts, hits))
+    }
+}
+
+impl SerialBackend {
+    /// [`Trace::trace`] on rays already in the scene's frame.
+    fn trace_in_frame(
+        &self,
+        scene: &Arc<PreparedScene>,
+        rays: &[Ray],
+        opts: &TraceOptions,
+        hits: &mut [Hit],
+    ) -> Result<Report, Error> {
         check_buffers(rays, hits)?;
         scene.check_prepared(opts.method)?;
         if let Method::Stream(m) = opts.method {

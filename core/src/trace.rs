@@ -111,6 +111,9 @@ pub struct Report {
     pub enumerations: Option<Vec<Vec<u32>>>,
     /// A stream method's working figures and stage times (stream methods only, always).
     pub stream: Option<StreamStats>,
+    /// Rays refused: answered [`Hit::REFUSED`] because no method can answer them reliably
+    /// ([`PreparedScene::frame_rays`]). Never counted as misses.
+    pub refused: usize,
 }
 
 impl Report {
@@ -124,6 +127,7 @@ impl Report {
             counters: None,
             enumerations: None,
             stream: None,
+            refused: 0,
         }
     }
 
@@ -145,6 +149,23 @@ pub fn check_buffers(rays: &[Ray], hits: &[Hit]) -> Result<(), Error> {
     } else {
         Err(Error::BufferMismatch { rays: rays.len(), hits: hits.len() })
     }
+}
+
+/// Traces a batch in `scene`'s frame ([`PreparedScene::frame_rays`]): checks the buffers, hands
+/// the framed rays to `trace`, puts the hits back in the caller's frame and counts the refused
+/// rays in the report. Every backend's [`Trace::trace`] goes through it, so all of them scale,
+/// move and refuse rays alike.
+pub fn trace_framed(
+    scene: &PreparedScene,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    trace: impl FnOnce(&[Ray], &mut [Hit]) -> Result<Report, Error>,
+) -> Result<Report, Error> {
+    check_buffers(rays, hits)?;
+    let framed = scene.frame_rays(rays);
+    let mut report = trace(framed.rays(), hits)?;
+    report.refused = framed.finish(hits);
+    Ok(report)
 }
 
 /// A backend: prepares a scene once, then traces batches of rays into hit buffers. Backends are

@@ -64,6 +64,21 @@ impl Trace for CpuBackend {
     }
 
     fn trace(&self, scene: &CpuScene, rays: &[Ray], opts: &TraceOptions, hits: &mut [Hit]) -> Result<Report, Error> {
+        raytrail_core::trace::trace_framed(&scene.0, rays, hits, |rays, hits| {
+            self.trace_in_frame(scene, rays, opts, hits)
+        })
+    }
+}
+
+impl CpuBackend {
+    /// [`Trace::trace`] on rays already in the scene's frame.
+    fn trace_in_frame(
+        &self,
+        scene: &CpuScene,
+        rays: &[Ray],
+        opts: &TraceOptions,
+        hits: &mut [Hit],
+    ) -> Result<Report, Error> {
         check_buffers(rays, hits)?;
         if !self.supports(opts.method) {
             return Err(Error::Unsupported { method: opts.method.name(), by: "the CPU backend" });

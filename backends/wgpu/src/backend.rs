@@ -179,6 +179,21 @@ impl Trace for WgpuBackend {
         options: &TraceOptions,
         hits: &mut [Hit],
     ) -> Result<Report, Error> {
+        raytrail_core::trace::trace_framed(&scene.prepared, rays, hits, |rays, hits| {
+            self.trace_in_frame(scene, rays, options, hits)
+        })
+    }
+}
+
+impl WgpuBackend {
+    /// [`Trace::trace`] on rays already in the scene's frame.
+    fn trace_in_frame(
+        &self,
+        scene: &WgpuScene,
+        rays: &[Ray],
+        options: &TraceOptions,
+        hits: &mut [Hit],
+    ) -> Result<Report, Error> {
         check_buffers(rays, hits)?;
         if !self.supports(options.method) {
             return Err(Error::Unsupported { method: options.method.name(), by: "the wgpu backend" });

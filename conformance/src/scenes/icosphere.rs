@@ -4,7 +4,7 @@ use glam::Vec3;
 use std::collections::HashMap;
 
 /// An indexed unit sphere mesh: `20 * 4^level` triangles, counter-clockwise seen from outside.
-pub(super) struct UnitSphere {
+pub(crate) struct UnitSphere {
     /// Vertices, on the unit sphere.
     pub positions: Vec<Vec3>,
     /// Vertex indices of each triangle.
@@ -12,7 +12,7 @@ pub(super) struct UnitSphere {
 }
 
 /// The icosahedron subdivided `level` times, new vertices pushed out onto the sphere.
-pub(super) fn unit_icosphere(level: u32) -> UnitSphere {
+pub(crate) fn unit_icosphere(level: u32) -> UnitSphere {
     let mut s = icosahedron();
     for _ in 0..level {
         s = subdivide(&s);

@@ -10,7 +10,7 @@
 
 mod far;
 mod grid;
-mod icosphere;
+pub(crate) mod icosphere;
 mod soup;
 mod sphereflake;
 mod stack;

@@ -3,7 +3,8 @@ use bytemuck::{Pod, Zeroable};
 /// The result of tracing one ray.
 ///
 /// The layout (16 bytes: `t`, `prim`, `u`, `v`) is the one of the CLI's `.npy` hit files. A miss
-/// has `t = +inf` and `prim = u32::MAX`.
+/// has `t = +inf` and `prim = u32::MAX`; a ray the numerics cannot answer is refused
+/// ([`Hit::REFUSED`]: `t` NaN, `prim = u32::MAX - 1`), never a miss.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Hit {
@@ -22,11 +23,23 @@ impl Hit {
     pub const NO_PRIM: u32 = u32::MAX;
     /// The miss.
     pub const MISS: Hit = Hit { t: f32::INFINITY, prim: Self::NO_PRIM, u: 0.0, v: 0.0 };
+    /// Primitive id of a refused ray.
+    pub const REFUSED_PRIM: u32 = u32::MAX - 1;
+    /// The answer for a ray no method can answer reliably (see
+    /// `PreparedScene::frame_rays`): `t` is NaN, so it is neither a hit nor a miss at any
+    /// distance, and it is counted in the `Report`.
+    pub const REFUSED: Hit = Hit { t: f32::NAN, prim: Self::REFUSED_PRIM, u: 0.0, v: 0.0 };
 
-    /// Whether this is a hit.
+    /// Whether this is a hit (not a miss, not refused).
     #[inline(always)]
     pub fn is_hit(&self) -> bool {
-        self.prim != Self::NO_PRIM
+        self.prim < Self::REFUSED_PRIM
+    }
+
+    /// Whether the ray was refused ([`Hit::REFUSED`]).
+    #[inline(always)]
+    pub fn is_refused(&self) -> bool {
+        self.prim == Self::REFUSED_PRIM
     }
 
     /// Whether a candidate at `t` on primitive `prim` replaces this one as the closest.

@@ -2,6 +2,10 @@
 //! and nothing more, plus the conventions every backend shares about it ([`PreparedScene::canonical_ids`]).
 
 mod enumeration;
+mod frame;
+pub mod normalize;
+
+pub use frame::{FramedRays, FAR_FACTOR, FAR_LIMIT};
 
 use crate::bvh2::traverse::TraceRoot;
 use crate::bvh2::{BinaryLayout, Bvh2, LinkKind, NodeRef, SliceMemory};
@@ -82,6 +86,10 @@ pub struct PreparedScene {
     pub levels: Option<LevelBvh>,
     /// Time spent on each part.
     pub timings: PrepareTimings,
+    /// The power of two the scene was scaled by: its coordinates here are the given ones times
+    /// `2^-exponent` ([`normalize`]; 0 for scenes of ordinary size). Rays go through
+    /// [`PreparedScene::frame_rays`], which scales them alike.
+    pub exponent: i32,
 }
 
 /// Seconds since `start` (a value this function returned), or a start mark when `None`.
@@ -101,6 +109,8 @@ pub(crate) fn seconds_since(_start: Option<f64>) -> f64 {
 impl PreparedScene {
     /// Derives what `methods` need from `bvh` over `scene`.
     pub fn new(scene: &Scene, bvh: Bvh2, methods: &[Method]) -> Result<PreparedScene, Error> {
+        let (scaled, bvh, exponent) = normalize::normalize(scene, bvh)?;
+        let scene = scaled.as_ref().unwrap_or(scene);
         let tris = scene.triangles();
         let mut timings = PrepareTimings::default();
         let t0 = seconds_since(None);
@@ -157,7 +167,20 @@ impl PreparedScene {
             None
         };
         timings.levels = seconds_since(Some(t5));
-        Ok(PreparedScene { bvh, uncles, parents, hash, full_hash, kd, wide4, wide8, wide4_naive, levels, timings })
+        Ok(PreparedScene {
+            bvh,
+            uncles,
+            parents,
+            hash,
+            full_hash,
+            kd,
+            wide4,
+            wide8,
+            wide4_naive,
+            levels,
+            timings,
+            exponent,
+        })
     }
 
     /// Key width the tree's depth needs.

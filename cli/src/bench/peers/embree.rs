@@ -32,7 +32,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Primitive id of an any hit, which Embree's occlusion query does not report.
-pub const UNKNOWN_PRIM: u32 = Hit::NO_PRIM - 1;
+pub const UNKNOWN_PRIM: u32 = Hit::REFUSED_PRIM - 1;
 
 /// An Embree scene over a raytrail scene: a bench target.
 pub struct Embree {

@@ -1,0 +1,208 @@
+//! What every backend does to a batch before and after tracing it: rays in the prepared scene's
+//! frame, far origins moved up to the scene, and rays no method can answer refused.
+//!
+//! Per ray, in this order:
+//! 1. **Scale** origin and direction by the scene's power of two ([`super::normalize`]); `t` is
+//!    unchanged. A ray that does not scale exactly (a component would overflow or lose bits to
+//!    underflow) is refused.
+//! 2. **Far origins.** The test subtracts the origin from each vertex in `f32`, so an origin far
+//!    from the scene rounds every vertex by `ulp(|origin|)`: at `1e5` scene diameters that moves
+//!    them by a hundredth of the scene, and methods that test boxes differently (kd against BVH2)
+//!    found different triangles. An origin whose largest coordinate exceeds [`FAR_FACTOR`] times
+//!    the scene's is moved along the ray to where it enters the scene box grown by an eighth of
+//!    its size: the entry `t0` is rounded down to an `f32`, the new origin `o + t0 d` is computed
+//!    in `f64` (the product is exact, the sum within `2^-53` of `|o|`) and rounded to `f32` (an
+//!    error of an ulp of the scene's coordinates, as for an origin inside it). The interval
+//!    becomes `[max(tmin - t0, 0), tmax - t0]`, and a hit's `t` comes back as `t0 + t` (rounded
+//!    once from `f64`). A ray that misses the grown box over its interval is a miss without
+//!    tracing; so is a far ray whose interval ends before the box.
+//!    An origin beyond [`FAR_LIMIT`] times the scene's magnitude is refused.
+//! 3. **Refusal.** A ray whose distances across the scene still come near the float range
+//!    ([`crate::intersect::RayContext::is_reliable`]) is refused.
+//!
+//! A refused ray is traced as a non-traceable ray (no work) and answered with [`Hit::REFUSED`];
+//! [`FramedRays::finish`] writes that and counts them for the [`crate::trace::Report`].
+
+use super::PreparedScene;
+use crate::intersect::SlabRay;
+use crate::prepared::normalize::scale_pow2;
+use crate::{Aabb, Hit, Ray};
+use alloc::borrow::Cow;
+use alloc::vec::Vec;
+
+/// Origins whose largest coordinate magnitude exceeds this many times the scene's are moved up
+/// to the scene (step 2 of the module docs).
+pub const FAR_FACTOR: f32 = 4.0;
+
+/// Origins whose largest coordinate magnitude exceeds this many times the scene's are refused:
+/// beyond it the `f64` sum that moves them up rounds by more than an ulp of the scene.
+pub const FAR_LIMIT: f32 = 4_294_967_296.0; // 2^32
+
+/// What happened to one ray of a batch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Fix {
+    /// Traced as given (scaled alike in origin and direction: `t` unchanged).
+    Keep,
+    /// A hit's `t` comes back as `(t0 + t) * 2^exp`: the ray was moved up by `t0` and its
+    /// direction scaled by `2^exp` more than its origin.
+    Moved(f32, i32),
+    /// A miss without tracing.
+    Miss,
+    /// Refused.
+    Refused,
+}
+
+/// A batch in the prepared scene's frame ([`PreparedScene::frame_rays`]).
+#[derive(Debug)]
+pub struct FramedRays<'a> {
+    rays: Cow<'a, [Ray]>,
+    /// Per ray where any ray changed, else empty.
+    fixes: Vec<Fix>,
+}
+
+/// A ray that every method answers as a miss without visiting a node.
+const NOTHING: Ray = Ray { origin: [0.0; 3], tmin: 1.0, dir: [0.0, 0.0, 1.0], tmax: 0.0 };
+
+impl FramedRays<'_> {
+    /// The rays to trace.
+    pub fn rays(&self) -> &[Ray] {
+        &self.rays
+    }
+
+    /// Puts the hits back in the caller's frame (moved rays' `t`, refused rays' [`Hit::REFUSED`])
+    /// and returns how many rays were refused.
+    pub fn finish(&self, hits: &mut [Hit]) -> usize {
+        let mut refused = 0;
+        for (hit, fix) in hits.iter_mut().zip(&self.fixes) {
+            match *fix {
+                Fix::Keep => {}
+                Fix::Moved(t0, exp) => {
+                    if hit.is_hit() {
+                        hit.t = scale_pow2((f64::from(t0) + f64::from(hit.t)) as f32, exp);
+                    }
+                }
+                Fix::Miss => *hit = Hit::MISS,
+                Fix::Refused => {
+                    *hit = Hit::REFUSED;
+                    refused += 1;
+                }
+            }
+        }
+        refused
+    }
+}
+
+/// `x * 2^-k` where that is exact.
+fn exact_scale(x: f32, k: i32) -> Option<f32> {
+    let y = scale_pow2(x, -k);
+    (y.is_finite() == x.is_finite() && scale_pow2(y, k) == x).then_some(y)
+}
+
+/// `ray` scaled by `2^-k` and the exponent `e` a hit's `t` must be scaled back by, or `None`
+/// where no exact scaling exists. Origin and direction scale alike where they can (`e = 0`);
+/// where the direction would overflow or underflow (unit directions into a scene of `1e-40`),
+/// it is scaled to a largest component in `[0.5, 1)` instead, and the interval with it.
+fn scaled(ray: &Ray, k: i32) -> Option<(Ray, i32)> {
+    if k == 0 {
+        return Some((*ray, 0));
+    }
+    let s = |v: [f32; 3], k: i32| -> Option<[f32; 3]> {
+        Some([exact_scale(v[0], k)?, exact_scale(v[1], k)?, exact_scale(v[2], k)?])
+    };
+    let origin = s(ray.origin, k)?;
+    if let Some(dir) = s(ray.dir, k) {
+        return Some((Ray { origin, dir, ..*ray }, 0));
+    }
+    let j = crate::prepared::normalize::exponent_of(ray.dir.iter().fold(0.0f32, |m, x| m.max(x.abs())));
+    let dir = s(ray.dir, j)?;
+    // t' = t * 2^(j - k): the interval scales by that, hits by its inverse.
+    let e = k - j;
+    Some((Ray { origin, dir, tmin: exact_scale(ray.tmin, e)?, tmax: exact_scale(ray.tmax, e)? }, e))
+}
+
+/// The `t` interval of `ray` (in `f64`) inside `b`, clipped to the ray's own.
+fn box_interval(ray: &Ray, b: &Aabb) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::from(ray.tmin), f64::from(ray.tmax));
+    for i in 0..3 {
+        let (o, d) = (f64::from(ray.origin[i]), f64::from(ray.dir[i]));
+        let (bl, bh) = (f64::from(b.min[i]), f64::from(b.max[i]));
+        if d == 0.0 {
+            if o < bl || o > bh {
+                return None;
+            }
+            continue;
+        }
+        let (a, c) = ((bl - o) / d, (bh - o) / d);
+        lo = lo.max(a.min(c));
+        hi = hi.min(a.max(c));
+    }
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// The largest `f32` not above `x` (for `x` within the `f32` range).
+fn f32_down(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) > x {
+        f32::from_bits(if y > 0.0 {
+            y.to_bits() - 1
+        } else if y == 0.0 {
+            0x8000_0001
+        } else {
+            y.to_bits() + 1
+        })
+    } else {
+        y
+    }
+}
+
+impl PreparedScene {
+    /// The batch `rays` in this scene's frame (see the module docs); borrows the rays where none
+    /// needs a change.
+    pub fn frame_rays<'a>(&self, rays: &'a [Ray]) -> FramedRays<'a> {
+        let scale = self.scene_scale();
+        let bounds = self.bvh.nodes()[0].bounds;
+        let grow = (bounds.extent().max_element() / 8.0).max(scale * f32::EPSILON * 64.0);
+        let grown = Aabb::new(bounds.min - grow, bounds.max + grow);
+        let far = FAR_FACTOR * scale;
+        let k = self.exponent;
+        let decide = |ray: &Ray| -> (Fix, Ray) {
+            if !ray.is_traceable() {
+                return (Fix::Keep, *ray);
+            }
+            let Some((r, exp)) = scaled(ray, k) else {
+                return (Fix::Refused, NOTHING);
+            };
+            let reach = r.origin().abs().max_element();
+            if reach > FAR_LIMIT * scale {
+                return (Fix::Refused, NOTHING);
+            }
+            let (fix, r) = if reach > far {
+                match box_interval(&r, &grown) {
+                    None => (Fix::Miss, NOTHING),
+                    Some((lo, _)) => {
+                        let t0 = f32_down(lo).max(r.tmin);
+                        let t0d = f64::from(t0);
+                        let o = core::array::from_fn(|i| (f64::from(r.origin[i]) + t0d * f64::from(r.dir[i])) as f32);
+                        let tmin = (f64::from(r.tmin) - t0d).max(0.0) as f32;
+                        let tmax = (f64::from(r.tmax) - t0d) as f32;
+                        (Fix::Moved(t0, exp), Ray { origin: o, tmin, dir: r.dir, tmax })
+                    }
+                }
+            } else if exp != 0 {
+                (Fix::Moved(0.0, exp), r)
+            } else {
+                (Fix::Keep, r)
+            };
+            if fix != Fix::Miss && !SlabRay::with_slack(&r, scale).slack.is_finite() {
+                return (Fix::Refused, NOTHING);
+            }
+            (fix, r)
+        };
+        // The common case changes nothing: check before copying.
+        if k == 0 && rays.iter().all(|r| decide(r) == (Fix::Keep, *r)) {
+            return FramedRays { rays: Cow::Borrowed(rays), fixes: Vec::new() };
+        }
+        let (fixes, out): (Vec<Fix>, Vec<Ray>) = rays.iter().map(decide).unzip();
+        FramedRays { rays: Cow::Owned(out), fixes }
+    }
+}
