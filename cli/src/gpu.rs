@@ -10,6 +10,15 @@ use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::gpu::{WgpuBackend, WgpuScene};
 use std::sync::Arc;
 
+/// Median seconds of a method's GPU passes.
+#[derive(Clone, Copy, Debug)]
+pub struct GpuTimes {
+    /// The whole call: uploads, kernels, read-backs.
+    pub end_to_end: f64,
+    /// The kernels alone (GPU timestamps), where the adapter has them.
+    pub kernel: Option<f64>,
+}
+
 /// The GPU side of a run, when there is an adapter.
 pub struct Gpu {
     backend: WgpuBackend,
@@ -27,9 +36,9 @@ impl Gpu {
     /// The adapter, the timer used, and what its compiler does to float arithmetic.
     pub fn describe(&self) -> String {
         let timer = if self.backend.has_gpu_timer() {
-            "GPU timestamps"
+            "end to end by the wall clock, kernels alone by GPU timestamps"
         } else {
-            "wall clock, transfers included (no timestamp queries)"
+            "end to end by the wall clock (no timestamp queries for the kernels alone)"
         };
         let probe = match self.backend.probe_numerics(1 << 16) {
             Ok(p) => p.summary(),
@@ -38,16 +47,21 @@ impl Gpu {
         format!("{}; timed by {timer}\n  numerics probe: {probe}", self.backend.adapter())
     }
 
-    /// Median seconds of `passes` timed traces (after one untimed pass that compiles the kernel).
-    pub fn time(&self, rays: &[Ray], method: Method, query: Query, passes: usize) -> Result<f64, String> {
+    /// Median seconds of `passes` timed traces (after one untimed pass that compiles the kernel):
+    /// end to end (uploads, kernels, read-backs), and the kernels alone where the adapter has
+    /// timestamps.
+    pub fn time(&self, rays: &[Ray], method: Method, query: Query, passes: usize) -> Result<GpuTimes, String> {
         let opts = TraceOptions::new(method).query(query);
         let mut hits = vec![Hit::MISS; rays.len()];
         self.backend.trace(&self.scene, rays, &opts, &mut hits).map_err(|e| e.to_string())?;
-        let mut times = Vec::with_capacity(passes);
+        let (mut wall, mut kernel) = (Vec::with_capacity(passes), Vec::with_capacity(passes));
         for _ in 0..passes {
-            times.push(self.backend.trace(&self.scene, rays, &opts, &mut hits).map_err(|e| e.to_string())?.seconds);
+            let r = self.backend.trace(&self.scene, rays, &opts, &mut hits).map_err(|e| e.to_string())?;
+            wall.push(r.seconds);
+            kernel.extend(r.kernel_seconds);
         }
-        Ok(crate::median::median(&times))
+        let kernel = (kernel.len() == wall.len() && !kernel.is_empty()).then(|| crate::median::median(&kernel));
+        Ok(GpuTimes { end_to_end: crate::median::median(&wall), kernel })
     }
 
     /// Traces `rays` once with `method` (`raytrail render --backend gpu`).

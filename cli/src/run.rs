@@ -28,7 +28,7 @@ struct SetResult<'a> {
     rows: Vec<Row>,
     checked: usize,
     mismatches: Vec<Mismatch>,
-    gpu: Option<(Vec<f64>, Vec<Mismatch>)>,
+    gpu: Option<(Vec<crate::gpu::GpuTimes>, Vec<Mismatch>)>,
     /// The stream method's working figures and stages (its counted run).
     stream: Option<StreamStats>,
 }
@@ -244,7 +244,7 @@ fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
         set.query.name(),
         t.checked
     );
-    let gpu_head = if t.gpu.is_some() { format!(" {:>9}", "GPU Mr/s") } else { String::new() };
+    let gpu_head = if t.gpu.is_some() { format!(" {:>9} {:>9}", "GPU e2e", "GPU kern") } else { String::new() };
     println!(
         "  {:<15} {:>9} {:>10}{gpu_head} {:>10} {:>12} {:>10} {:>10} {:>8}  conformance",
         "method", "Mrays/s", "vs stack", "nodes/ray", "backtr./ray", "hash/ray", "links/ray", "state B"
@@ -255,7 +255,9 @@ fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
         let gpu_col = match &t.gpu {
             Some((secs, gm)) => {
                 bad += gm.iter().filter(|x| x.method == *m).count();
-                format!(" {:>9.2}", set.rays.len() as f64 / secs[i] / 1e6)
+                let mrays = |s: f64| set.rays.len() as f64 / s / 1e6;
+                let kernel = secs[i].kernel.map_or("-".to_string(), |k| format!("{:.2}", mrays(k)));
+                format!(" {:>9.2} {kernel:>9}", mrays(secs[i].end_to_end))
             }
             None => String::new(),
         };

@@ -114,6 +114,20 @@ struct RowView<'a> {
     tests_per_ray: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     stream: Option<StreamView<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    kernel: Option<KernelView<'a>>,
+}
+
+/// A GPU target's kernel time at steady clocks (its row's own figures are end to end).
+#[derive(Serialize)]
+struct KernelView<'a> {
+    mrays_per_s: f64,
+    min_mrays_per_s: f64,
+    max_mrays_per_s: f64,
+    samples_s: &'a [f64],
+    passes_per_sample: usize,
+    warm_up_s: f64,
+    bytes_per_trace: u64,
 }
 
 /// A stream target's stage seconds and working figures.
@@ -146,6 +160,18 @@ impl<'a> From<&'a Row> for RowView<'a> {
             nodes_per_ray: w.nodes,
             leaves_per_ray: w.leaves,
             tests_per_ray: w.tests,
+            kernel: r.kernel.as_ref().map(|k| {
+                let (lo, hi) = k.spread();
+                KernelView {
+                    mrays_per_s: k.median_mrays_per_s(),
+                    min_mrays_per_s: lo,
+                    max_mrays_per_s: hi,
+                    samples_s: &k.seconds,
+                    passes_per_sample: k.passes_per_sample,
+                    warm_up_s: k.warm_up_seconds,
+                    bytes_per_trace: k.bytes_per_trace,
+                }
+            }),
             stream: r.stream.as_ref().map(|st| StreamView {
                 packets: st.packets,
                 active_frustums: st.active_frustums,
@@ -209,6 +235,7 @@ mod tests {
             ratio,
             work,
             stream: None,
+            kernel: None,
         };
         let agreement = Agreement {
             rays: 10,

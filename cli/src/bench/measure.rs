@@ -96,6 +96,7 @@ impl Plan<'_> {
                     ratio: None,
                     work: None,
                     stream: None,
+                    kernel: None,
                 });
             }
         }
@@ -103,9 +104,11 @@ impl Plan<'_> {
             for t in self.targets {
                 let work = t.work(pool, rays, query)?;
                 let stream = t.stream_stats(pool, rays, query)?;
+                let kernel = t.kernel_timing(rays, query)?;
                 for r in rows.iter_mut().filter(|r| r.target == t.name()) {
                     r.work = work;
                     r.stream.clone_from(&stream);
+                    r.kernel.clone_from(&kernel);
                 }
                 progress.step(&format!("{kind} {} work", t.name()));
             }

@@ -260,14 +260,22 @@ fn gpu_targets(opts: &Options, cpu: &CpuScene) -> Result<Targets, String> {
             return Ok(Vec::new());
         }
     };
-    let timer = if backend.has_gpu_timer() { "GPU timestamps" } else { "the wall clock, transfers included" };
-    println!("  GPU: {}, timed by {timer}", backend.adapter());
+    let kernel = if backend.has_gpu_timer() {
+        "kernels alone by GPU timestamps at steady clocks"
+    } else {
+        "no kernel time (no timestamp queries)"
+    };
+    println!("  GPU: {}; passes timed end to end by the wall clock, {kernel}", backend.adapter());
     let scene = Arc::new(backend.prepare(cpu.0.clone()).map_err(|e| e.to_string())?);
-    Ok(opts
-        .methods
-        .iter()
-        .map(|&m| Box::new(RaytrailGpu::new(m, backend.clone(), scene.clone())) as Box<dyn BenchTarget>)
-        .collect())
+    let mut targets: Targets = Vec::new();
+    for config in &opts.gpu {
+        let b = Arc::new(backend.configured(*config).map_err(|e| format!("--gpu-dispatch/--gpu-workgroup: {e}"))?);
+        // The stream method's kernels have their own dispatch: one target is enough.
+        for m in opts.methods.iter().copied().filter(|m| m.stream().is_none() || *config == opts.gpu[0]) {
+            targets.push(Box::new(RaytrailGpu::new(m, b.clone(), scene.clone(), opts.gpu_warm_up)));
+        }
+    }
+    Ok(targets)
 }
 
 #[cfg(test)]

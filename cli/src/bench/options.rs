@@ -6,6 +6,7 @@ use crate::args::{LoadFlags, BUILDERS};
 use clap::Parser;
 use raytrail::core::method::Method;
 use raytrail::core::stream::{StreamParams, MAX_PACKET};
+use raytrail::gpu::{Dispatch, GpuConfig};
 use raytrail::{Builder, BUILTIN_SCENE};
 
 /// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
@@ -65,6 +66,10 @@ pub struct Options {
     pub strict: bool,
     /// Parameter sets of the stream method: one target per set (the first is the default's).
     pub stream: Vec<StreamParams>,
+    /// GPU settings: one GPU target per method and setting (the first is the default's).
+    pub gpu: Vec<GpuConfig>,
+    /// Untimed GPU tracing before a GPU target's kernel is timed.
+    pub gpu_warm_up: std::time::Duration,
 }
 
 /// The `raytrail bench` flags as given; [`Options::from_args`] checks them.
@@ -122,6 +127,16 @@ pub struct BenchArgs {
     /// comma-separated for a parameter study [default: 0.004]
     #[arg(long, value_name = "F[,F...]")]
     pub stream_cell: Option<String>,
+    /// GPU dispatch: grid, persistent or persistent:<workgroups>, comma-separated for a sweep
+    /// [default: grid]
+    #[arg(long, value_name = "D[,D...]")]
+    pub gpu_dispatch: Option<String>,
+    /// GPU workgroup size, comma-separated for a sweep [default: 64]
+    #[arg(long, value_name = "N[,N...]")]
+    pub gpu_workgroup: Option<String>,
+    /// Seconds of untimed GPU tracing before each GPU kernel is timed (clocks rise under load)
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.5)]
+    pub gpu_warm_up: f64,
     /// Camera views: outside, inside, both, or auto (inside too where it sees a room)
     #[arg(long, default_value = ViewChoice::DEFAULT.name(), value_parser = ViewChoice::ALL.map(ViewChoice::name))]
     pub view: String,
@@ -236,7 +251,13 @@ impl Options {
             (None, _) => "obvhs-bvh2".to_string(),
         };
         let stream = stream_params(a.stream_packet.as_deref(), a.stream_cell.as_deref())?;
+        let gpu = gpu_configs(a.gpu_dispatch.as_deref(), a.gpu_workgroup.as_deref())?;
+        if !(a.gpu_warm_up.is_finite() && (0.0..=600.0).contains(&a.gpu_warm_up)) {
+            return Err(format!("--gpu-warm-up: {} is not a number of seconds from 0 to 600", a.gpu_warm_up));
+        }
         Ok(Options {
+            gpu,
+            gpu_warm_up: std::time::Duration::from_secs_f64(a.gpu_warm_up),
             stream,
             scenes,
             rays,
@@ -292,6 +313,41 @@ fn stream_params(packets: Option<&str>, cells: Option<&str>) -> Result<Vec<Strea
             })
             .collect(),
     ))
+}
+
+/// Every combination of the given GPU dispatches and workgroup sizes (defaults where not given).
+fn gpu_configs(dispatches: Option<&str>, workgroups: Option<&str>) -> Result<Vec<GpuConfig>, String> {
+    let base = GpuConfig::default();
+    let dispatches: Vec<Dispatch> = match dispatches {
+        None => vec![base.dispatch],
+        Some(v) => list(v)
+            .iter()
+            .map(|d| Dispatch::parse(d).map_err(|e| format!("--gpu-dispatch: {e}")))
+            .collect::<Result<_, _>>()?,
+    };
+    let sizes: Vec<u32> = match workgroups {
+        None => vec![base.workgroup_size],
+        Some(v) => list(v)
+            .iter()
+            .map(|n| match n.parse::<u32>() {
+                Ok(k) if (1..=1024).contains(&k) => Ok(k),
+                _ => Err(format!("--gpu-workgroup: '{n}' is not a workgroup size between 1 and 1024")),
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    if dispatches.is_empty() || sizes.is_empty() {
+        return Err("--gpu-dispatch/--gpu-workgroup: no value given".to_string());
+    }
+    let mut out: Vec<GpuConfig> = Vec::new();
+    for &dispatch in &dispatches {
+        for &workgroup_size in &sizes {
+            let c = GpuConfig { dispatch, workgroup_size, ..base };
+            if !out.contains(&c) {
+                out.push(c);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// The non-empty items of a comma-separated list, trimmed.

@@ -288,6 +288,7 @@ mod tests {
             ratio: None,
             work: None,
             stream: None,
+            kernel: None,
         };
         let rays = RayReport {
             kind: RayKind::Primary,

@@ -6,6 +6,7 @@ use super::rays::RayKind;
 use super::target::{TargetKind, Work};
 use super::view::View;
 use raytrail::core::stream::StreamStats;
+use raytrail::gpu::KernelTiming;
 
 /// One build step: what was built, how long it took, and the memory it holds.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,6 +40,9 @@ pub struct Row {
     pub work: Option<Work>,
     /// A stream method's stages and working figures (from the work pass).
     pub stream: Option<StreamStats>,
+    /// A GPU target's kernel time at steady clocks (the row's own speed is end to end: uploads,
+    /// kernels and read-backs of every pass).
+    pub kernel: Option<KernelTiming>,
 }
 
 /// Every row for one ray type of one scene.

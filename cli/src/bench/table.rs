@@ -84,6 +84,7 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
         }
     }
     print_stream_stages(r);
+    print_gpu_kernels(r);
     let notes: Vec<String> = r
         .agreement
         .iter()
@@ -136,6 +137,44 @@ fn print_stream_stages(r: &RayReport) {
             per(st.leaf_refs),
             st.largest_list,
             mb(st.working_bytes)
+        );
+    }
+}
+
+/// The GPU targets' two speeds: end to end (the table's, transfers included) and the kernel alone
+/// at steady clocks, with its spread and the bandwidth the transfers took.
+fn print_gpu_kernels(r: &RayReport) {
+    let mut seen: Vec<&str> = Vec::new();
+    let rows: Vec<&Row> = r
+        .rows
+        .iter()
+        .filter(|row| {
+            row.kernel.is_some() && !seen.contains(&row.target.as_str()) && {
+                seen.push(&row.target);
+                true
+            }
+        })
+        .collect();
+    if rows.is_empty() {
+        return;
+    }
+    println!(
+        "  GPU Mrays/s:                           {:>10} {:>10} {:>19} {:>9} {:>10}",
+        "end to end", "kernel", "kernel min-max", "MB moved", "GB/s e2e"
+    );
+    for row in rows {
+        let Some(k) = &row.kernel else { continue };
+        let (lo, hi) = k.spread();
+        let gbs = if row.median_s > 0.0 { k.bytes_per_trace as f64 / row.median_s / 1e9 } else { 0.0 };
+        println!(
+            "  {:<38} {:>10.1} {:>10.1} {:>9.1}-{:<9.1} {:>9.1} {:>10.2}",
+            row.target,
+            row.mrays_per_s,
+            k.median_mrays_per_s(),
+            lo,
+            hi,
+            k.bytes_per_trace as f64 / 1e6,
+            gbs
         );
     }
 }

@@ -7,6 +7,7 @@ use raytrail::core::stream::{StreamParams, StreamStats};
 use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
+use raytrail::gpu::KernelTiming;
 
 /// What a target is, for grouping and colouring.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,6 +92,11 @@ pub trait BenchTarget: Send + Sync {
         _rays: &[Ray],
         _query: Query,
     ) -> Result<Option<StreamStats>, String> {
+        Ok(None)
+    }
+    /// A GPU target's kernel time at steady clocks (rays uploaded once, many passes between two
+    /// timestamps); `None` for every other target.
+    fn kernel_timing(&self, _rays: &[Ray], _query: Query) -> Result<Option<KernelTiming>, String> {
         Ok(None)
     }
 }

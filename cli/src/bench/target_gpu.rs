@@ -5,21 +5,32 @@ use raytrail::core::method::{Method, Query};
 use raytrail::core::stream::StreamStats;
 use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
-use raytrail::gpu::{WgpuBackend, WgpuScene};
+use raytrail::gpu::{GpuConfig, KernelTiming, TimingPlan, WgpuBackend, WgpuScene};
 use std::sync::Arc;
+use std::time::Duration;
 
-/// One method on the GPU. The thread pool does not apply: the GPU traces the whole batch.
+/// One method on the GPU. The thread pool does not apply: the GPU traces the whole batch. Its
+/// passes are timed end to end by the wall clock (uploads, kernels, read-backs); the kernel alone
+/// is timed separately ([`BenchTarget::kernel_timing`]).
 pub struct RaytrailGpu {
     method: Method,
     name: String,
     backend: Arc<WgpuBackend>,
     scene: Arc<WgpuScene>,
+    timing: TimingPlan,
 }
 
 impl RaytrailGpu {
-    /// The target tracing `method` over `scene` on `backend`.
-    pub fn new(method: Method, backend: Arc<WgpuBackend>, scene: Arc<WgpuScene>) -> Self {
-        Self { method, name: format!("gpu:{}", method.name()), backend, scene }
+    /// The target tracing `method` over `scene` on `backend`, named `gpu:<method>` for the default
+    /// settings and `gpu:<method>/<dispatch>/<workgroup size>` otherwise (a sweep's targets).
+    pub fn new(method: Method, backend: Arc<WgpuBackend>, scene: Arc<WgpuScene>, warm_up: Duration) -> Self {
+        let name = if *backend.config() == GpuConfig::default() {
+            format!("gpu:{}", method.name())
+        } else {
+            format!("gpu:{}/{}", method.name(), backend.config().label())
+        };
+        let timing = TimingPlan { warm_up, ..TimingPlan::default() };
+        Self { method, name, backend, scene, timing }
     }
 
     fn run(
@@ -51,15 +62,15 @@ impl BenchTarget for RaytrailGpu {
         true
     }
 
-    fn trace_timed(
-        &self,
-        _pool: &rayon::ThreadPool,
-        rays: &[Ray],
-        query: Query,
-        hits: &mut [Hit],
-    ) -> Result<Option<f64>, String> {
-        let report = self.run(rays, query, hits, Record::Nothing)?;
-        Ok(self.backend.has_gpu_timer().then_some(report.seconds))
+    fn kernel_timing(&self, rays: &[Ray], query: Query) -> Result<Option<KernelTiming>, String> {
+        if !self.backend.has_gpu_timer() || rays.is_empty() {
+            return Ok(None);
+        }
+        let opts = TraceOptions::new(self.method).query(query);
+        self.backend
+            .time_kernel(&self.scene, rays, &opts, &self.timing)
+            .map(Some)
+            .map_err(|e| format!("{}: {e}", self.name))
     }
 
     fn work(&self, _pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Option<Work>, String> {
