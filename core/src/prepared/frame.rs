@@ -24,11 +24,12 @@
 //! [`FramedRays::finish`] writes that and counts them for the [`crate::trace::Report`].
 
 use super::PreparedScene;
-use crate::intersect::SlabRay;
+use crate::intersect::{SlabRay, RELIABLE_LIMIT};
 use crate::prepared::normalize::scale_pow2;
 use crate::{Aabb, Hit, Ray};
 use alloc::borrow::Cow;
 use alloc::vec::Vec;
+use glam::Vec3A;
 
 /// Origins whose largest coordinate magnitude exceeds this many times the scene's are moved up
 /// to the scene (step 2 of the module docs).
@@ -139,6 +140,22 @@ fn box_interval(ray: &Ray, b: &Aabb) -> Option<(f64, f64)> {
     (lo <= hi).then_some((lo, hi))
 }
 
+/// Whether `ray` surely needs no change in an unscaled scene of magnitude `scale`: its origin is
+/// within `far`, and its slack is finite with room to spare. The slack is finite when
+/// `reach^2 * (reach / max|d|) < RELIABLE_LIMIT` with `reach = scale + max|origin|`, each step
+/// rounded in `f32` ([`SlabRay::with_slack`]); the half-dozen roundings here and there, of at most
+/// `2^-24` each, are far inside the margin of `2^-8`, and an overflow to infinity only sends the
+/// ray to the exact decision. A ray with a NaN component may be cleared: untraceable, it is kept
+/// as given anyway.
+#[inline]
+fn surely_kept(ray: &Ray, scale: f32, far: f32) -> bool {
+    // Lane-wise, as `Ray::is_traceable` does: a few vector instructions per ray.
+    let reach = Vec3A::from_array(ray.origin).abs().max_element();
+    let max_d = Vec3A::from_array(ray.dir).abs().max_element();
+    let r = scale + reach;
+    reach <= far && r * r * r * (1.0 + 1.0 / 256.0) < RELIABLE_LIMIT * max_d
+}
+
 /// The largest `f32` not above `x` (for `x` within the `f32` range).
 fn f32_down(x: f64) -> f32 {
     let y = x as f32;
@@ -155,54 +172,135 @@ fn f32_down(x: f64) -> f32 {
     }
 }
 
+/// The constants of one scene's framing decision.
+struct Frame {
+    /// The scene's largest coordinate magnitude (after its own scaling).
+    scale: f32,
+    /// The scene box grown by an eighth of its size: where far origins are moved to.
+    grown: Aabb,
+    /// Origins beyond this are far.
+    far: f32,
+    /// The scene's power-of-two exponent.
+    k: i32,
+}
+
+impl Frame {
+    /// What happens to `ray`, and the ray to trace.
+    fn decide(&self, ray: &Ray) -> (Fix, Ray) {
+        let Frame { scale, grown, far, k } = *self;
+        if !ray.is_traceable() {
+            return (Fix::Keep, *ray);
+        }
+        let Some((r, exp)) = scaled(ray, k) else {
+            return (Fix::Refused, NOTHING);
+        };
+        let reach = r.origin().abs().max_element();
+        if reach > FAR_LIMIT * scale {
+            return (Fix::Refused, NOTHING);
+        }
+        let (fix, r) = if reach > far {
+            match box_interval(&r, &grown) {
+                None => (Fix::Miss, NOTHING),
+                Some((lo, _)) => {
+                    let t0 = f32_down(lo).max(r.tmin);
+                    let t0d = f64::from(t0);
+                    let o = core::array::from_fn(|i| (f64::from(r.origin[i]) + t0d * f64::from(r.dir[i])) as f32);
+                    let tmin = (f64::from(r.tmin) - t0d).max(0.0) as f32;
+                    let tmax = (f64::from(r.tmax) - t0d) as f32;
+                    (Fix::Moved(t0, exp), Ray { origin: o, tmin, dir: r.dir, tmax })
+                }
+            }
+        } else if exp != 0 {
+            (Fix::Moved(0.0, exp), r)
+        } else {
+            (Fix::Keep, r)
+        };
+        if fix != Fix::Miss && !SlabRay::with_slack(&r, scale).slack.is_finite() {
+            return (Fix::Refused, NOTHING);
+        }
+        (fix, r)
+    }
+
+    /// Whether `ray` is traced as given: first a filter of a few multiplies (the exact decision
+    /// divides, and a serial pass of it cost a quarter of a fast method's trace), then the exact
+    /// decision for the rays the filter does not clear.
+    fn keeps(&self, ray: &Ray) -> bool {
+        self.k == 0 && (surely_kept(ray, self.scale, self.far) || self.decide(ray) == (Fix::Keep, *ray))
+    }
+}
+
 impl PreparedScene {
-    /// The batch `rays` in this scene's frame (see the module docs); borrows the rays where none
-    /// needs a change.
-    pub fn frame_rays<'a>(&self, rays: &'a [Ray]) -> FramedRays<'a> {
+    fn frame(&self) -> Frame {
         let scale = self.scene_scale();
         let bounds = self.bvh.nodes()[0].bounds;
         let grow = (bounds.extent().max_element() / 8.0).max(scale * f32::EPSILON * 64.0);
         let grown = Aabb::new(bounds.min - grow, bounds.max + grow);
-        let far = FAR_FACTOR * scale;
-        let k = self.exponent;
-        let decide = |ray: &Ray| -> (Fix, Ray) {
-            if !ray.is_traceable() {
-                return (Fix::Keep, *ray);
-            }
-            let Some((r, exp)) = scaled(ray, k) else {
-                return (Fix::Refused, NOTHING);
-            };
-            let reach = r.origin().abs().max_element();
-            if reach > FAR_LIMIT * scale {
-                return (Fix::Refused, NOTHING);
-            }
-            let (fix, r) = if reach > far {
-                match box_interval(&r, &grown) {
-                    None => (Fix::Miss, NOTHING),
-                    Some((lo, _)) => {
-                        let t0 = f32_down(lo).max(r.tmin);
-                        let t0d = f64::from(t0);
-                        let o = core::array::from_fn(|i| (f64::from(r.origin[i]) + t0d * f64::from(r.dir[i])) as f32);
-                        let tmin = (f64::from(r.tmin) - t0d).max(0.0) as f32;
-                        let tmax = (f64::from(r.tmax) - t0d) as f32;
-                        (Fix::Moved(t0, exp), Ray { origin: o, tmin, dir: r.dir, tmax })
-                    }
-                }
-            } else if exp != 0 {
-                (Fix::Moved(0.0, exp), r)
-            } else {
-                (Fix::Keep, r)
-            };
-            if fix != Fix::Miss && !SlabRay::with_slack(&r, scale).slack.is_finite() {
-                return (Fix::Refused, NOTHING);
-            }
-            (fix, r)
-        };
-        // The common case changes nothing: check before copying.
-        if k == 0 && rays.iter().all(|r| decide(r) == (Fix::Keep, *r)) {
+        Frame { scale, grown, far: FAR_FACTOR * scale, k: self.exponent }
+    }
+
+    /// Whether [`PreparedScene::frame_rays`] would change any ray of `rays`. A backend may ask
+    /// this of a batch's chunks in parallel and, where none needs a change, trace the batch as
+    /// given (the usual case: no copy, no refusals).
+    pub fn needs_framing(&self, rays: &[Ray]) -> bool {
+        let frame = self.frame();
+        // Without a branch per ray (the compiler vectorizes it), then exactly where that fails.
+        let cleared = frame.k == 0 && rays.iter().fold(true, |all, r| all & surely_kept(r, frame.scale, frame.far));
+        !cleared && !rays.iter().all(|r| frame.keeps(r))
+    }
+
+    /// The batch `rays` in this scene's frame (see the module docs); borrows the rays where none
+    /// needs a change.
+    pub fn frame_rays<'a>(&self, rays: &'a [Ray]) -> FramedRays<'a> {
+        let frame = self.frame();
+        if rays.iter().all(|r| frame.keeps(r)) {
             return FramedRays { rays: Cow::Borrowed(rays), fixes: Vec::new() };
         }
-        let (fixes, out): (Vec<Fix>, Vec<Ray>) = rays.iter().map(decide).unzip();
+        let (fixes, out): (Vec<Fix>, Vec<Ray>) = rays.iter().map(|r| frame.decide(r)).unzip();
         FramedRays { rays: Cow::Owned(out), fixes }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The filter clears only rays the exact decision keeps in an unscaled scene (origin within
+    /// the far threshold, finite slack): rays from all over the float range.
+    #[test]
+    fn the_filter_clears_only_rays_the_exact_decision_keeps() {
+        let scale = 3.0f32;
+        let far = FAR_FACTOR * scale;
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (mut cleared, mut checked) = (0, 0);
+        for _ in 0..200_000 {
+            // Magnitudes 2^-120 .. 2^120, both signs, any mix per component.
+            let mut v = || {
+                let bits = next();
+                let mag = 2f32.powi((bits % 241) as i32 - 120) * (1.0 + (bits >> 32) as f32 / 4.3e9);
+                if bits & (1 << 20) != 0 {
+                    -mag
+                } else {
+                    mag
+                }
+            };
+            let ray = Ray { origin: [v(), v(), v()], tmin: 0.0, dir: [v(), v(), v()], tmax: f32::INFINITY };
+            if !ray.is_traceable() {
+                continue;
+            }
+            checked += 1;
+            if surely_kept(&ray, scale, far) {
+                cleared += 1;
+                let reach = ray.origin.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+                assert!(reach <= far, "cleared a far ray: {ray:?}");
+                assert!(SlabRay::with_slack(&ray, scale).slack.is_finite(), "cleared an unreliable ray: {ray:?}");
+            }
+        }
+        assert!(cleared > checked / 10 && cleared < checked, "{cleared} of {checked} cleared");
     }
 }
