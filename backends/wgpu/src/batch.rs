@@ -195,13 +195,18 @@ pub(crate) fn run(
                 .map_err(|e| device_error(format!("mapping a read-back buffer: {e}")))?;
         }
         let slot = ws.slot(gpu, p.slot, 0, 0, max_bytes);
+        // Each buffer read is unmapped; what a failure leaves mapped is unmapped before the slot's
+        // next batch (`Slot::unmap_leftovers`).
         take(&slot.hit_back, &mut hits[p.first..p.first + p.rays])?;
+        slot.mapped &= !1;
         if stride > 0 {
             take(&slot.record_back, &mut records[p.first * stride..(p.first + p.rays) * stride])?;
+            slot.mapped &= !2;
         }
         if let Some(t) = &slot.timer {
             let mut stamps = [0u64; 2];
             take(&t.back, &mut stamps)?;
+            slot.mapped &= !4;
             gpu_seconds = gpu_seconds.map(|s| s + stamps[1].saturating_sub(stamps[0]) as f64 * period);
         } else {
             gpu_seconds = None;
@@ -221,6 +226,7 @@ pub(crate) fn run(
             let d = grid(gpu, launch, items)?;
             let params = d.params(launch.params, n);
             let slot = ws.slot(gpu, slot_index, n, n * stride, max_bytes);
+            slot.unmap_leftovers();
             gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&params));
             gpu.queue.write_buffer(&slot.rays, 0, bytemuck::cast_slice(chunk));
             let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
@@ -237,11 +243,14 @@ pub(crate) fn run(
             }
             let submission = gpu.queue.submit([enc.finish()]);
             let mut mapped = vec![map(&slot.hit_back, hit_bytes)];
+            slot.mapped = 1;
             if record_bytes > 0 {
                 mapped.push(map(&slot.record_back, record_bytes));
+                slot.mapped |= 2;
             }
             if let Some(t) = &slot.timer {
                 mapped.push(map(&t.back, 16));
+                slot.mapped |= 4;
             }
             pending.push_back(Pending { slot: slot_index, first: b * per_batch, rays: n, submission, mapped });
         }

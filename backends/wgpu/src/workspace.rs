@@ -29,6 +29,9 @@ pub(crate) struct Slot {
     pub record_capacity: usize,
     /// Bind groups by method (a method binds the same scene buffers every time).
     binds: HashMap<Method, wgpu::BindGroup>,
+    /// Read-back buffers mapped or being mapped and not yet read: bit 0 hits, 1 records, 2 the
+    /// timestamps.
+    pub mapped: u8,
 }
 
 /// A slot's timestamp queries.
@@ -118,6 +121,7 @@ impl Workspace {
             ray_capacity,
             record_capacity,
             binds: HashMap::new(),
+            mapped: 0,
         }
     }
 
@@ -128,6 +132,18 @@ impl Workspace {
 }
 
 impl Slot {
+    /// Unmaps read-back buffers a failed trace left mapped (or waiting to be), so that the slot can
+    /// take a new batch.
+    pub fn unmap_leftovers(&mut self) {
+        let backs = [Some(&self.hit_back), Some(&self.record_back), self.timer.as_ref().map(|t| &t.back)];
+        for (bit, b) in backs.into_iter().enumerate() {
+            if let Some(b) = b.filter(|_| self.mapped & (1 << bit) != 0) {
+                b.unmap();
+            }
+        }
+        self.mapped = 0;
+    }
+
     /// The bind group of `method` over this slot's buffers and `scene`'s, made on first use.
     pub fn bind_group(
         &mut self,

@@ -270,10 +270,13 @@ fn gpu_targets(opts: &Options, cpu: &CpuScene) -> Result<Targets, String> {
     let mut targets: Targets = Vec::new();
     for config in &opts.gpu {
         let b = Arc::new(backend.configured(*config).map_err(|e| format!("--gpu-dispatch/--gpu-workgroup: {e}"))?);
-        // The stream method's kernels have their own dispatch: one target is enough.
-        for m in opts.methods.iter().copied().filter(|m| m.stream().is_none() || *config == opts.gpu[0]) {
+        for m in opts.methods.iter().copied().filter(|m| m.stream().is_none()) {
             targets.push(Box::new(RaytrailGpu::new(m, b.clone(), scene.clone(), opts.gpu_warm_up)));
         }
+    }
+    // The stream method's kernels have their own dispatch: one target, `gpu:stream`.
+    for m in opts.methods.iter().copied().filter(|m| m.stream().is_some()) {
+        targets.push(Box::new(RaytrailGpu::new(m, backend.clone(), scene.clone(), opts.gpu_warm_up)));
     }
     Ok(targets)
 }

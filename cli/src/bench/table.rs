@@ -36,7 +36,9 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
         r.kind.query().name(),
         if passes == 1 { "" } else { "es" }
     );
-    let mut header = format!("  {:<20}", "target");
+    // Names of a sweep's targets (`gpu:bvh8/persistent/32`) are longer than most.
+    let width = r.agreement.iter().map(|(name, _)| name.len()).max().unwrap_or(0).max(20);
+    let mut header = format!("  {:<width$}", "target");
     for t in &threads {
         header += &format!(" {:>8} {:>7}", format!("{t} thr"), "ratio");
     }
@@ -44,7 +46,7 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
     header += if any { "  same occlusion" } else { "  same hit  within 1e-5" };
     println!("{header}");
     for (name, agreement) in &r.agreement {
-        let mut line = format!("  {name:<20}");
+        let mut line = format!("  {name:<width$}");
         let mut work = None;
         for t in &threads {
             match r.rows.iter().find(|row| &row.target == name && row.threads == *t) {

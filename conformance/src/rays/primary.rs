@@ -66,13 +66,29 @@ impl Camera {
     /// The ray through the point `(px, py)` of a `width` x `height` image (pixel units, y down;
     /// pixel centers at half-integers): unit direction, `t` in `[0, inf]`.
     pub fn ray(&self, px: f32, py: f32, width: u32, height: u32) -> Ray {
-        let forward = (self.target - self.eye).normalize();
+        let forward = unit(self.target - self.eye);
         let (right, up) = self.basis(forward);
         let half_h = self.tan_half_vfov;
         let half_w = half_h * width as f32 / height as f32;
         let sx = (2.0 * px / width as f32 - 1.0) * half_w;
         let sy = (1.0 - 2.0 * py / height as f32) * half_h;
-        Ray::new(self.eye, (forward + right * sx + up * sy).normalize(), 0.0, f32::INFINITY)
+        Ray::new(self.eye, unit(forward + right * sx + up * sy), 0.0, f32::INFINITY)
+    }
+}
+
+/// `v` scaled to unit length at any magnitude. Where `|v|^2` is a normal float this is glam's
+/// `normalize` (so ordinary scenes keep their rays bit for bit); where it underflows or overflows
+/// (a scene at 1e-40 or 1e37), `v` is first divided by its largest component, which squares
+/// safely: plain `normalize` gave NaN directions there.
+fn unit(v: Vec3) -> Vec3 {
+    if v.length_squared().is_normal() {
+        return v.normalize();
+    }
+    let m = v.abs().max_element();
+    if m > 0.0 && m.is_finite() {
+        (v / m).normalize()
+    } else {
+        v.normalize()
     }
 }
 
@@ -115,6 +131,24 @@ pub fn primary(scene: &Scene, width: u32, height: u32) -> Vec<Ray> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Directions are unit vectors at every scene scale (they were NaN at 1e-40 and 1e37), and
+    /// about the same as at scale 1.
+    #[test]
+    fn primary_rays_have_unit_directions_at_any_scale() {
+        let at = |s: f32| {
+            let b = Aabb::new(Vec3::new(-1.0, -2.0, -3.0) * s, Vec3::new(3.0, 2.0, 1.0) * s);
+            primary_from(&Camera::framing(b), 8, 6)
+        };
+        let unit = at(1.0);
+        for s in [1e-40f32, 1e-30, 1e30, 1e37] {
+            for (r, u) in at(s).iter().zip(&unit) {
+                let d = Vec3::from_array(r.dir);
+                assert!(d.is_finite() && (d.length() - 1.0).abs() < 1e-5, "scale {s}: {r:?}");
+                assert!(d.distance(Vec3::from_array(u.dir)) < 1e-3, "scale {s}: {d} against {:?}", u.dir);
+            }
+        }
+    }
 
     #[test]
     fn morton_order_of_4x4() {

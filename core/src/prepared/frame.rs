@@ -99,10 +99,16 @@ fn exact_scale(x: f32, k: i32) -> Option<f32> {
     (y.is_finite() == x.is_finite() && scale_pow2(y, k) == x).then_some(y)
 }
 
+/// Bounds on a direction's largest component scaled alike with its origin (2^-64, 2^64): beyond
+/// them it is scaled on its own ([`scaled`]).
+const MODERATE_MIN: f32 = 1.0 / MODERATE_MAX;
+const MODERATE_MAX: f32 = 18_446_744_073_709_551_616.0;
+
 /// `ray` scaled by `2^-k` and the exponent `e` a hit's `t` must be scaled back by, or `None`
-/// where no exact scaling exists. Origin and direction scale alike where they can (`e = 0`);
-/// where the direction would overflow or underflow (unit directions into a scene of `1e-40`),
-/// it is scaled to a largest component in `[0.5, 1)` instead, and the interval with it.
+/// where no exact scaling exists. Origin and direction scale alike where they can and the
+/// direction stays moderate (`e = 0`); where it would overflow, underflow or leave
+/// [`MODERATE_MIN`]..=[`MODERATE_MAX`] (unit directions into a scene of `1e-40` or `1e37`), it is
+/// scaled to a largest component in `[0.5, 1)` instead, and the interval with it.
 fn scaled(ray: &Ray, k: i32) -> Option<(Ray, i32)> {
     if k == 0 {
         return Some((*ray, 0));
@@ -111,7 +117,11 @@ fn scaled(ray: &Ray, k: i32) -> Option<(Ray, i32)> {
         Some([exact_scale(v[0], k)?, exact_scale(v[1], k)?, exact_scale(v[2], k)?])
     };
     let origin = s(ray.origin, k)?;
-    if let Some(dir) = s(ray.dir, k) {
+    // Alike only where the direction keeps a moderate size: scaled by 2^-125 with the origin (a
+    // scene at 1e37), a unit direction made every ray fail the reliability bound (`reach^3 / |d|`)
+    // and be refused, though its own scaling is exact.
+    let moderate = |d: &[f32; 3]| (MODERATE_MIN..=MODERATE_MAX).contains(&d[0].abs().max(d[1].abs()).max(d[2].abs()));
+    if let Some(dir) = s(ray.dir, k).filter(moderate) {
         return Some((Ray { origin, dir, ..*ray }, 0));
     }
     let j = crate::prepared::normalize::exponent_of(ray.dir.iter().fold(0.0f32, |m, x| m.max(x.abs())));
@@ -302,5 +312,22 @@ mod tests {
             }
         }
         assert!(cleared > checked / 10 && cleared < checked, "{cleared} of {checked} cleared");
+    }
+
+    /// A camera ray into a scene at 1e37 (scaled by 2^-125): its unit direction scales exactly
+    /// with the origin, but so small that the ray failed the reliability bound and was refused.
+    /// Scaled on its own, it stays reliable, and a hit's `t` is scaled back by 2^125.
+    #[test]
+    fn unit_directions_into_huge_scenes_stay_reliable() {
+        let ray = Ray {
+            origin: [4.756_067e37, 5.105_386e37, 8.271_189e37],
+            tmin: 0.0,
+            dir: [-0.680_795_9, 0.022_825_062, -0.732_117_5],
+            tmax: f32::INFINITY,
+        };
+        let (r, e) = scaled(&ray, 125).expect("scales exactly");
+        assert_eq!(e, 125);
+        assert_eq!(r.dir, ray.dir, "a unit direction keeps its size");
+        assert!(SlabRay::with_slack(&r, 0.8).slack.is_finite());
     }
 }
