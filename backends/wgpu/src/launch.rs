@@ -104,15 +104,15 @@ pub(crate) fn launch<'a>(
 }
 
 /// The kd-packet kernel's rays, grouped as the core groups them (every backend alike): slot `s`
-/// of the result holds ray `order[s]`, padding as untraceable rays, so that packet `p` is slots
-/// `PACKET_WIDTH * p ..`. `None` for every other method.
+/// holds ray `order[s]`, padding as untraceable rays, so that packet `p` is slots
+/// `PACKET_WIDTH * p ..`.
 pub(crate) struct Arranged {
     pub order: Vec<u32>,
     pub rays: Vec<Ray>,
 }
 
 impl Arranged {
-    /// The arrangement of `rays` for `method`, if it needs one.
+    /// The arrangement of `rays` for `method`; `None` for every method but kd-packet.
     pub fn of(method: Method, rays: &[Ray]) -> Option<Arranged> {
         if method != Method::Kd(KdMethod::Packet) {
             return None;

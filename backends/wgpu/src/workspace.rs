@@ -83,7 +83,9 @@ impl Workspace {
 
     /// A slot for `rays` rays and `record_words` words, capacities rounded up within `max_bytes`.
     fn make(&mut self, gpu: &Gpu, rays: usize, record_words: usize, max_bytes: u64) -> Slot {
-        let cap = |n: usize, unit: u64| (grown(n) as u64 * unit).min(max_bytes.max(unit * n as u64)).max(16);
+        // Rounded up for growth, but not past the largest binding unless the batch itself needs it
+        // (batches are sized to fit), and never empty.
+        let cap = |n: usize, unit: u64| (grown(n) as u64 * unit).min(max_bytes).max(n as u64 * unit).max(16);
         let ray_bytes = cap(rays, RAY_BYTES);
         let hit_bytes = cap(rays, HIT_BYTES);
         let record_bytes = cap(record_words, 4);
