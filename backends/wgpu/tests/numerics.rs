@@ -3,23 +3,13 @@
 //! kernel form the backend picks and, separately, as SPIR-V asking for preserved subnormals.
 //! Skipped with a one-line reason without an adapter, unless `RAYTRAIL_REQUIRE_GPU=1`.
 
-use raytrail_wgpu::{KernelForm, WgpuBackend, REQUIRE_GPU};
-use std::io::Write;
+mod common;
+
+use raytrail_wgpu::{KernelForm, WgpuBackend};
 
 /// The backend in `form`, or `None` (with the reason on stderr) where there is no adapter.
 fn open(form: KernelForm) -> Option<WgpuBackend> {
-    match WgpuBackend::with_kernel_form(form) {
-        Ok(b) => Some(b),
-        Err(e) if std::env::var(REQUIRE_GPU).as_deref() == Ok("1") => panic!("{REQUIRE_GPU}=1 but: {e}"),
-        Err(e) => {
-            // Past the harness's output capture, so a plain `cargo test` shows why.
-            let _ = writeln!(
-                std::io::stderr(),
-                "SKIPPED the wgpu numerics probe ({form:?} kernels): {e} (set {REQUIRE_GPU}=1 to make this a failure)"
-            );
-            None
-        }
-    }
+    common::open_or_skip("the wgpu numerics probe", || WgpuBackend::with_kernel_form(form))
 }
 
 fn check(backend: &WgpuBackend) {

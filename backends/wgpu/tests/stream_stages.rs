@@ -8,6 +8,8 @@
 //!
 //! Skipped with a one-line reason without an adapter, unless `RAYTRAIL_REQUIRE_GPU=1`.
 
+mod common;
+
 use raytrail_conformance::rays::RaySetSize;
 use raytrail_conformance::reference::SerialBackend;
 use raytrail_conformance::suite::{generated_scene, GENERATED_RAYS, MESH_RAYS};
@@ -21,24 +23,13 @@ use raytrail_core::stream::ray_hash::RayGrid;
 use raytrail_core::stream::{FrustumCull, Serial, StreamParams};
 use raytrail_core::trace::{Record, Trace, TraceOptions};
 use raytrail_core::{Hit, Ray};
-use raytrail_wgpu::{WgpuBackend, REQUIRE_GPU};
-use std::io::Write;
+use raytrail_wgpu::WgpuBackend;
 use std::sync::Arc;
 
 const STREAM: Method = Method::Stream(StreamMethod::Frustum8);
 
 fn open() -> Option<WgpuBackend> {
-    match WgpuBackend::new() {
-        Ok(b) => Some(b),
-        Err(e) if std::env::var(REQUIRE_GPU).as_deref() == Ok("1") => panic!("{REQUIRE_GPU}=1 but: {e}"),
-        Err(e) => {
-            let _ = writeln!(
-                std::io::stderr(),
-                "SKIPPED the stream stage checks: {e} (set {REQUIRE_GPU}=1 to make this a failure)"
-            );
-            None
-        }
-    }
+    common::open_or_skip("the stream stage checks", WgpuBackend::new)
 }
 
 /// The scene prepared for the stream method (and the stack method, which makes the ray sets).

@@ -9,6 +9,8 @@
 //! `conformance_persistent.rs`.) Skipped with a one-line reason without an adapter, unless
 //! `RAYTRAIL_REQUIRE_GPU=1`.
 
+mod common;
+
 use raytrail_conformance::suite::{generated_scene, GENERATED_RAYS};
 use raytrail_conformance::{ray_sets, NamedScene};
 use raytrail_core::bvh2::SahBuilder;
@@ -16,23 +18,12 @@ use raytrail_core::method::{Bvh2Method, Method, Query, StreamMethod, WideMethod}
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, Trace, TraceOptions};
 use raytrail_core::{Hit, Ray};
-use raytrail_wgpu::{Dispatch, GpuConfig, TimingPlan, WgpuBackend, WgpuScene, REQUIRE_GPU};
-use std::io::Write;
+use raytrail_wgpu::{Dispatch, GpuConfig, TimingPlan, WgpuBackend, WgpuScene};
 use std::sync::Arc;
 use std::time::Duration;
 
 fn open() -> Option<WgpuBackend> {
-    match WgpuBackend::new() {
-        Ok(b) => Some(b),
-        Err(e) if std::env::var(REQUIRE_GPU).as_deref() == Ok("1") => panic!("{REQUIRE_GPU}=1 but: {e}"),
-        Err(e) => {
-            let _ = writeln!(
-                std::io::stderr(),
-                "SKIPPED the wgpu stream and dispatch checks: {e} (set {REQUIRE_GPU}=1 to make this a failure)"
-            );
-            None
-        }
-    }
+    common::open_or_skip("the wgpu stream and dispatch checks", WgpuBackend::new)
 }
 
 /// `named` prepared for every method, on `backend`, with the suite's ray sets (all of them in one).
