@@ -142,6 +142,70 @@ pub enum Command {
     /// visited, or backtracking steps) of any --method, so that methods can be compared by eye.
     #[command(after_help = AFTER_HELP)]
     Render(RenderArgs),
+    /// Run time against error: every method and triangle test timed, and judged against the exact
+    /// reference
+    #[command(
+        long_about = "Times every method with every triangle test on the CPU (all threads; Mrays/s, median of \
+                      --passes on the full ray set) and judges a sample of each ray set against the exact reference \
+                      (integer arithmetic on the f32 inputs): false misses, false hits, wrong primitives, t beyond \
+                      the tolerance, and the t error in ulps. Prints a table per scene and ray type with the Pareto \
+                      front of speed against error marked; --json and --plot write the results and an SVG plot.",
+        after_help = AFTER_HELP
+    )]
+    Accuracy(AccuracyArgs),
+}
+
+/// The triangle tests `raytrail accuracy` can measure, by command-line name.
+pub const TRIANGLE_TESTS: [&str; 2] = ["watertight", "moller-trumbore"];
+
+/// `raytrail accuracy`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct AccuracyArgs {
+    /// Scene files (or `builtin`), comma-separated
+    #[arg(long, short = 's', value_name = "FILE[,FILE...]", value_delimiter = ',', default_value = BUILTIN_SCENE)]
+    pub scene: Vec<String>,
+    /// Ray types, comma-separated: primary, shadow, soft-shadow, diffuse, ao
+    #[arg(long, value_name = "TYPE[,TYPE...]", value_delimiter = ',', default_value = "primary,shadow,diffuse,ao")]
+    pub rays: Vec<String>,
+    /// Methods, comma-separated, or all
+    #[arg(long, value_name = "NAME[,NAME...]|all", value_delimiter = ',', default_value = "all")]
+    pub methods: Vec<String>,
+    /// Triangle tests, comma-separated: watertight, moller-trumbore
+    #[arg(long, value_name = "TEST[,TEST...]", value_delimiter = ',', default_value = "watertight,moller-trumbore",
+          value_parser = TRIANGLE_TESTS)]
+    pub tests: Vec<String>,
+    /// Primary image width
+    #[arg(long, short = 'W', default_value_t = 320, value_parser = clap::value_parser!(u32).range(1..))]
+    pub width: u32,
+    /// Primary image height
+    #[arg(long, short = 'H', default_value_t = 240, value_parser = clap::value_parser!(u32).range(1..))]
+    pub height: u32,
+    /// Rays per ray set judged against the exact reference (evenly spaced over the set)
+    #[arg(long, value_name = "N", default_value_t = 4096, value_parser = clap::value_parser!(u64).range(1..))]
+    pub sample: u64,
+    /// Timed passes per method and test, after one untimed pass (the median is reported)
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    pub passes: u32,
+    /// Ambient-occlusion rays per primary hit
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub ao_rays: u32,
+    /// Camera views: outside, inside, both, or auto (inside too where it sees a room)
+    #[arg(long, default_value = "auto", value_parser = ["outside", "inside", "both", "auto"])]
+    pub view: String,
+    /// BVH2 builder
+    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    pub builder: String,
+    /// Also write the results as JSON
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<String>,
+    /// Also write an SVG plot of Mrays/s against error rate, the Pareto front marked
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<String>,
+    /// Most rays per ray set
+    #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    #[command(flatten)]
+    pub load: LoadFlags,
 }
 
 /// The mesh loading flags.

@@ -43,12 +43,19 @@ impl ExactAnswer {
 
 /// The exact closest hit of `ray` among `triangles` (primitive ids are indices).
 pub fn closest_hit(ray: &Ray, triangles: &[Triangle]) -> ExactAnswer {
+    closest_among(ray, triangles, 0..triangles.len() as u32)
+}
+
+/// The exact closest hit of `ray` among the `candidates` of `triangles` (ascending ids; ids out
+/// of range are skipped). It equals [`closest_hit`] whenever no triangle left out of
+/// `candidates` is hit: what a conservative culling ([`super::accel`]) guarantees.
+pub fn closest_among(ray: &Ray, triangles: &[Triangle], candidates: impl IntoIterator<Item = u32>) -> ExactAnswer {
     if !ray.is_traceable() {
         return ExactAnswer::miss();
     }
     let mut hits = Vec::new();
-    for (prim, tri) in triangles.iter().enumerate() {
-        let prim = prim as u32;
+    for prim in candidates {
+        let Some(tri) = triangles.get(prim as usize) else { continue };
         match filter(ray, tri) {
             Filtered::Miss => {}
             Filtered::Hit { lo, hi } => hits.push(AnyHit { prim, lo, hi }),

@@ -17,12 +17,16 @@
 //!   (watertightness promises at least one); every winner is the answer there.
 //! - How a method's answer is judged against it, with the one tolerance rounding forces, is in
 //!   [`verdict`].
+//! - For big scenes, [`accel::ExactScene`] gives the same answers faster: a BVH used only to cull
+//!   triangles the ray provably cannot meet (slab tests widened by a proven rounding bound).
 
+pub mod accel;
 pub mod closest;
 pub mod dyadic;
 pub mod filter;
 pub mod triangle;
 pub mod verdict;
 
-pub use closest::{closest_hit, ExactAnswer};
+pub use accel::ExactScene;
+pub use closest::{closest_among, closest_hit, ExactAnswer};
 pub use verdict::{judge, Judgement, Tolerance};
