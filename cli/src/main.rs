@@ -1,9 +1,10 @@
-//! The `raytrail` command line: the main job (no arguments), `trace`, `rays`, `bench` and
-//! `render`. Flags are declared with clap in [`args`]; usage errors exit with status 2, failures
+//! The `raytrail` command line: the main job (no arguments), `trace`, `rays`, `bench`, `render`
+//! and `explain`. Flags are declared with clap in [`args`]; usage errors exit with status 2, failures
 //! while working with status 1.
 
 mod args;
 mod bench;
+mod explain;
 mod gpu;
 mod limits;
 mod median;
@@ -28,6 +29,7 @@ fn main() {
         // The report records the command as given.
         Some(Command::Bench(a)) => bench::main(a, &raw[2.min(raw.len())..]),
         Some(Command::Render(a)) => render::main(a),
+        Some(Command::Explain(a)) => explain::main(a),
     };
     match result {
         Ok(0) => {}

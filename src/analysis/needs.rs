@@ -4,8 +4,8 @@
 
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Bvh2Method, Method};
-use raytrail_core::scene::Scene;
 use raytrail_core::prepared::PreparedScene;
+use raytrail_core::scene::Scene;
 use raytrail_core::{Hit, Ray};
 
 /// Whether a feature is needed, and why (a sentence for reports).
@@ -150,8 +150,8 @@ impl Needs {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use raytrail_core::glam::Vec3;
     use raytrail_core::geometry::Triangle;
+    use raytrail_core::glam::Vec3;
     use raytrail_core::method::{KdMethod, WideMethod};
 
     fn tri(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> Triangle {

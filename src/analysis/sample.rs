@@ -74,14 +74,17 @@ impl SampleClock for CpuClock<'_> {
 }
 
 /// Chooses among [`CANDIDATES`] (those `scene` holds) for `rays` traced with `query`, timing a
-/// [`sample`] of them on the CPU backend. One untimed trace per candidate first warms caches and
-/// the thread pool, so the first timed round is not the cold one.
+/// [`sample`] of them on the CPU backend, after one untimed trace. The cost counted in the
+/// choice is every trace's time, that one included.
 ///
 /// Fails with [`Error::NotPrepared`] when the scene holds none of the candidates, and
 /// [`Error::InvalidParameter`] for an empty batch.
 pub fn choose_on_cpu(backend: &CpuBackend, scene: &CpuScene, rays: &[Ray], query: Query) -> Result<Choice, Error> {
     if rays.is_empty() {
-        return Err(Error::InvalidParameter { name: "rays", why: "a method is chosen for a batch of at least one ray" });
+        return Err(Error::InvalidParameter {
+            name: "rays",
+            why: "a method is chosen for a batch of at least one ray",
+        });
     }
     let candidates: Vec<Method> = CANDIDATES.into_iter().filter(|&m| scene.0.check_prepared(m).is_ok()).collect();
     if candidates.is_empty() {
@@ -89,10 +92,9 @@ pub fn choose_on_cpu(backend: &CpuBackend, scene: &CpuScene, rays: &[Ray], query
     }
     let sample = sample(rays);
     let mut clock = CpuClock::new(backend, scene, &sample, query);
-    let mut warm = 0.0;
-    for &m in &candidates {
-        warm += clock.seconds(m)?;
-    }
+    // One untimed trace starts the thread pool's workers (the first trace in a process pays for
+    // that) so that the first candidate's first round is not judged by it.
+    let warm = clock.seconds(candidates[0])?;
     let mut choice = choose(&candidates, ROUNDS, &mut clock)?;
     choice.cost_seconds += warm;
     Ok(choice)

@@ -51,8 +51,13 @@ mod tests {
     fn one_kernel_per_distinct_method_and_query() {
         let bvh8 = Method::Wide(WideMethod::Bvh8);
         let kd = Method::Kd(KdMethod::Stack);
-        let chosen =
-            [(kd, Query::Closest), (bvh8, Query::Any), (bvh8, Query::Any), (bvh8, Query::Closest), (kd, Query::Closest)];
+        let chosen = [
+            (kd, Query::Closest),
+            (bvh8, Query::Any),
+            (bvh8, Query::Any),
+            (bvh8, Query::Closest),
+            (kd, Query::Closest),
+        ];
         let v = variants_for(KeyWidth::W32, &chosen);
         assert_eq!(v.len(), 3);
         assert!(v.iter().all(|v| v.keys == KeyWidth::W32 && v.record == Record::Nothing));
