@@ -131,21 +131,12 @@ fn print(name: &str, builder: &str, build_s: f64, a: &SceneAnalysis) {
         println!("  {}", line.join(", "));
     }
     if !a.choices.is_empty() {
-        println!("\nmethod per ray set (candidates timed on a sample on the CPU; median of the rounds, µs):");
+        println!("\nmethod per ray set (candidates timed on a sample on the CPU):");
         println!(
-            "  {:<22} {:<7} {:>9} {:>7} {:<10} {:>9} {:>9}  candidates",
+            "  {:<22} {:<7} {:>9} {:>7} {:<10} {:>9} {:>9}  candidates, in",
             "rays", "query", "rays", "sample", "chosen", "choose ms", "% batch"
         );
         for c in &a.choices {
-            let cands: Vec<String> = c
-                .choice
-                .timed
-                .iter()
-                .map(|t| {
-                    let mark = if t.pruned() { " (dropped)" } else { "" };
-                    format!("{} {:.0}{mark}", t.method.name(), 1e6 * t.median())
-                })
-                .collect();
             println!(
                 "  {:<22} {:<7} {:>9} {:>7} {:<10} {:>9.2} {:>8.1}%  {}",
                 c.label,
@@ -155,7 +146,7 @@ fn print(name: &str, builder: &str, build_s: f64, a: &SceneAnalysis) {
                 c.choice.method.name(),
                 1e3 * c.choice.cost_seconds,
                 100.0 * c.choice.cost_seconds / c.batch_seconds.max(1e-12),
-                cands.join(", ")
+                c.choice.summary()
             );
         }
     }
@@ -227,7 +218,7 @@ fn to_json(name: &str, a: &SceneAnalysis) -> serde_json::Value {
             "choose_s": c.choice.cost_seconds,
             "batch_s": c.batch_seconds,
             "candidates": c.choice.timed.iter().map(|t| json!({
-                "method": t.method.name(), "seconds": t.seconds, "median_s": t.median(), "dropped": t.pruned(),
+                "method": t.method.name(), "first_look_s": t.first, "rounds_s": t.seconds, "dropped": t.pruned(),
             })).collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
         "needs": {

@@ -247,22 +247,15 @@ fn print_auto_choices(
             .and_then(|r| r.rows.iter().find(|row| row.target == crate::args::AUTO && Some(row.threads) == threads))
             .map_or(f64::NAN, |row| row.median_s);
         let kind = report.map_or("?", |r| r.kind.name());
-        let medians: Vec<String> = c
-            .timed
-            .iter()
-            .map(|t| {
-                format!("{} {:.0}{}", t.method.name(), 1e6 * t.median(), if t.pruned() { " (dropped)" } else { "" })
-            })
-            .collect();
         println!(
             "  auto [{view}, {kind}, {} thr]: {} on a {}-ray sample; choosing took {:.2} ms = {:.1}% of one trace of \
-             the batch; medians µs: {}",
+             the batch; {}",
             threads.unwrap_or(0),
             c.method,
             raytrail::analysis::sample::sample_size(n),
             1e3 * c.cost_seconds,
             100.0 * c.cost_seconds / batch_s,
-            medians.join(", ")
+            c.summary()
         );
     }
 }
