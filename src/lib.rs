@@ -35,6 +35,7 @@
 //! library pulls in no bench dependency. docs/ARCHITECTURE.md tells how the parts fit.
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod prelude;
 
 pub use raytrail_conformance as conformance;

@@ -67,7 +67,9 @@ pub fn usage<T>(m: impl Into<String>) -> Result<T, Failure> {
 const AFTER_HELP: &str = "\
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
          kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree);
-         bvh4, bvh8, bvh4-naive (wide BVH)
+         bvh4, bvh8, bvh4-naive (wide BVH); stream (ray stream);
+         auto (trace's default; bench --methods): the fastest of bvh8, kd-stack, stack and stream
+         timed on a sample of the rays (`raytrail explain SCENE` shows the choice per ray type)
 SCENES:  OBJ, PLY (ASCII or binary), OFF, STL (ASCII or binary), glTF 2.0 (.gltf, .glb), any of them
          gzip-compressed; `builtin` is a generated sphereflake. Elements that are not triangles or
          polygons (2-vertex faces, OBJ lines and points) are skipped with one warning line;
@@ -135,6 +137,17 @@ pub enum Command {
         after_help = AFTER_HELP
     )]
     Bench(crate::bench::options::BenchArgs),
+    /// Tells what a scene needs: tables and their sizes, features, kernels, a method per ray type
+    #[command(
+        long_about = "Analyses a scene: every table each method would build (bytes, build time), whether 64-bit keys, \
+                      hash tables, the f64 fallback, the disjoint mask and the slack are needed, which wgpu kernels \
+                      would be compiled, and which method to use per ray type, chosen by timing a few candidates on a \
+                      sample of the rays on the CPU (what --method auto does). Without --rays, the bench's ray types \
+                      (primary, shadow, soft-shadow, diffuse, ao) from the outside view, and the inside view where \
+                      it sees a room.",
+        after_help = AFTER_HELP
+    )]
+    Explain(ExplainArgs),
     /// Renders the scene to a PNG: normals, ambient occlusion, or a heat map of traversal work
     ///
     /// Primary rays in raster order through the outside or inside camera; the image shows the hit
@@ -241,6 +254,20 @@ pub fn method_names() -> PossibleValuesParser {
     PossibleValuesParser::new(Method::ALL.map(Method::name))
 }
 
+/// The name that asks for the method to be chosen by timing candidates on a sample of the rays
+/// (`raytrail::analysis`).
+pub const AUTO: &str = "auto";
+
+/// The method names and [`AUTO`], for `--method` where a method can be chosen.
+pub fn method_names_or_auto() -> PossibleValuesParser {
+    PossibleValuesParser::new(std::iter::once(AUTO).chain(Method::ALL.map(Method::name)))
+}
+
+/// A `--method` value: a fixed method, or `None` for [`AUTO`].
+pub fn method_or_auto(name: &str) -> Option<Method> {
+    (name != AUTO).then(|| method(name))
+}
+
 /// The builder of a name that clap has checked.
 pub fn builder(name: &str) -> Builder {
     Builder::from_name(name).unwrap_or_default()
@@ -294,8 +321,8 @@ pub struct TraceArgs {
     /// The NumPy ray file to trace
     #[arg(long, value_name = "RAYS.npy")]
     pub rays: String,
-    /// Traversal method
-    #[arg(long, short = 'm', default_value = "hash", value_parser = method_names(), hide_possible_values = true)]
+    /// Traversal method, or auto: the fastest of a few candidates timed on a sample of the rays
+    #[arg(long, short = 'm', default_value = AUTO, value_parser = method_names_or_auto(), hide_possible_values = true)]
     pub method: String,
     /// The NumPy hit file to write
     #[arg(long, short = 'o', value_name = "HITS.npy")]
@@ -313,6 +340,40 @@ pub struct TraceArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub prim_map: Option<String>,
     /// Most rays the ray file may hold
+    #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    #[command(flatten)]
+    pub load: LoadFlags,
+}
+
+/// `raytrail explain`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ExplainArgs {
+    /// Scene file, or `builtin`
+    #[arg(value_name = "SCENE")]
+    pub scene: String,
+    /// A NumPy ray file to choose a method for (instead of the generated ray types)
+    #[arg(long, value_name = "RAYS.npy")]
+    pub rays: Option<String>,
+    /// The --rays are any-hit (occlusion) queries
+    #[arg(long, requires = "rays")]
+    pub any: bool,
+    /// Also write the analysis as JSON
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<String>,
+    /// BVH2 builder
+    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    pub builder: String,
+    /// Width of the generated primary image
+    #[arg(long, short = 'W', default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..))]
+    pub width: u32,
+    /// Height of the generated primary image
+    #[arg(long, short = 'H', default_value_t = 192, value_parser = clap::value_parser!(u32).range(1..))]
+    pub height: u32,
+    /// Camera views of the generated rays: outside, inside, both, or auto (inside too where it sees a room)
+    #[arg(long, default_value = "auto", value_parser = ["outside", "inside", "both", "auto"])]
+    pub view: String,
+    /// Most rays per set
     #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
     pub max_rays: u64,
     #[command(flatten)]

@@ -1,10 +1,11 @@
-//! The `raytrail` command line: the main job (no arguments), `trace`, `rays`, `bench`, `render`
-//! and `accuracy`. Flags are declared with clap in [`args`]; usage errors exit with status 2,
-//! failures while working with status 1.
+//! The `raytrail` command line: the main job (no arguments), `trace`, `rays`, `bench`, `render`,
+//! `accuracy` and `explain`. Flags are declared with clap in [`args`]; usage errors exit with status
+//! 2, failures while working with status 1.
 
 mod accuracy;
 mod args;
 mod bench;
+mod explain;
 mod gpu;
 mod limits;
 mod median;
@@ -30,6 +31,7 @@ fn main() {
         Some(Command::Bench(a)) => bench::main(a, &raw[2.min(raw.len())..]),
         Some(Command::Render(a)) => render::main(a),
         Some(Command::Accuracy(a)) => accuracy::main(a, &raw[2.min(raw.len())..]),
+        Some(Command::Explain(a)) => explain::main(a),
     };
     match result {
         Ok(0) => {}

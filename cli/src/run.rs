@@ -1,5 +1,6 @@
 //! The main job: build, prepare, trace primary, shadow and diffuse rays with every method, and
-//! report speed, work per ray, state size, hash-table figures and the conformance verdict.
+//! report speed, work per ray, state size, hash-table figures, what `--method auto` picks per ray
+//! set, and the conformance verdict.
 
 use crate::args::{builder, check_input, load_scene, warn, Outcome, RunArgs};
 use crate::limits::check_image;
@@ -33,6 +34,8 @@ struct SetResult<'a> {
     stream: Option<StreamStats>,
     /// Rays refused as outside the supported numeric range (the most any method refused).
     refused: usize,
+    /// What `--method auto` chooses for the set (the default method of `trace`).
+    auto: raytrail::analysis::choice::Choice,
 }
 
 struct RaySetRun {
@@ -80,7 +83,8 @@ pub fn main(a: RunArgs) -> Outcome {
     let sets = ray_sets(&backend, &cpu, scene, width, height)?;
     let mut failures: Vec<Mismatch> = Vec::new();
     let gpu_steps = if gpu.is_some() { sets.len() * (Method::ALL.len() + 1) } else { 0 };
-    let mut progress = Progress::new("tracing", sets.len() * Method::ALL.len() * (passes + 1) + sets.len() + gpu_steps);
+    let mut progress =
+        Progress::new("tracing", sets.len() * Method::ALL.len() * (passes + 1) + 2 * sets.len() + gpu_steps);
     let mut tables = Vec::new();
     for set in &sets {
         let mut rows = Vec::new();
@@ -102,6 +106,9 @@ pub fn main(a: RunArgs) -> Outcome {
             refused = refused.max(counted.refused);
             rows.push((method, median(&times), counted.counters.unwrap_or_default()));
         }
+        let auto = raytrail::analysis::sample::choose_on_cpu(&backend, &cpu, &set.rays, set.query)
+            .map_err(|e| format!("auto: {e}"))?;
+        progress.step(&format!("{} auto", set.name));
         // Conformance on an evenly spread subset: recording every node of every ray is heavy.
         let step = set.rays.len().div_ceil(check_rays.max(1)).max(1);
         let subset: Vec<Ray> = set.rays.iter().step_by(step).copied().collect();
@@ -124,7 +131,7 @@ pub fn main(a: RunArgs) -> Outcome {
             }
             None => None,
         };
-        tables.push(SetResult { set, rows, checked: subset.len(), mismatches, gpu: gpu_result, stream, refused });
+        tables.push(SetResult { set, rows, checked: subset.len(), mismatches, gpu: gpu_result, stream, refused, auto });
     }
     progress.finish();
     for t in &tables {
@@ -290,6 +297,19 @@ fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
             if bad == 0 { "ok".to_string() } else { format!("MISMATCH on {bad} checks") }
         );
     }
+    // What `--method auto` (the default of `raytrail trace`) picks here, and against what.
+    let a = &t.auto;
+    let chosen_s = t.rows.iter().find(|r| r.0 == a.method).map_or(f64::NAN, |r| r.1);
+    let fastest = t.rows.iter().min_by(|x, y| x.1.total_cmp(&y.1));
+    println!(
+        "  auto: {} ({:.2} Mrays/s above; the fastest is {}), chosen on a {}-ray sample in {:.2} ms = {:.1}% of one trace",
+        a.method,
+        set.rays.len() as f64 / chosen_s / 1e6,
+        fastest.map_or("?".to_string(), |f| format!("{} at {:.2}", f.0, set.rays.len() as f64 / f.1 / 1e6)),
+        raytrail::analysis::sample::sample_size(set.rays.len()),
+        1e3 * a.cost_seconds,
+        100.0 * a.cost_seconds / chosen_s
+    );
 }
 
 /// Interior nodes per ray of the kd methods against the kd stack traversal (Horn et al. 2007,

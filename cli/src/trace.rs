@@ -1,12 +1,12 @@
 //! `raytrail trace` and `raytrail rays`: NumPy files in and out.
 
-use crate::args::{builder, check_input, check_output, load_scene, method, warn, write_prim_map, Outcome};
+use crate::args::{builder, check_input, check_output, load_scene, method_or_auto, warn, write_prim_map, Outcome};
 use crate::args::{RaysArgs, TraceArgs};
 use crate::limits::{check_count, check_image, try_vec};
 use crate::progress::timed;
 use raytrail::conformance::rays::{primary_from, Camera};
 use raytrail::core::mesh::LoadOptions;
-use raytrail::core::method::Query;
+use raytrail::core::method::{Bvh2Method, Method, Query};
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::{Trace, TraceOptions, TriangleTestKind};
 use raytrail::core::{Hit, Ray};
@@ -18,7 +18,7 @@ use std::sync::Arc;
 const RAY_AND_HIT_BYTES: u64 = (std::mem::size_of::<Ray>() + std::mem::size_of::<Hit>()) as u64;
 
 pub fn main(a: TraceArgs) -> Outcome {
-    let method = method(&a.method);
+    let method = method_or_auto(&a.method);
     let builder = builder(&a.builder);
     // Every output location and input file is checked before any work.
     check_output("out", &a.out)?;
@@ -41,13 +41,41 @@ pub fn main(a: TraceArgs) -> Outcome {
     }
     crate::args::ploc_note(builder, &named.scene);
     let (bvh, _) = timed("building the BVH2", || builder.build(&named.scene));
-    let prepared =
-        PreparedScene::new(&named.scene, bvh.map_err(|e| e.to_string())?, &[method]).map_err(|e| e.to_string())?;
+    let bvh = bvh.map_err(|e| e.to_string())?;
     let backend = CpuBackend::new();
+    let query = if a.any { Query::Any } else { Query::Closest };
+    let (prepared, method) = match method {
+        Some(m) => (PreparedScene::new(&named.scene, bvh, &[m]).map_err(|e| e.to_string())?, m),
+        None if rays.is_empty() => {
+            // Nothing to sample: any method traces no rays alike; the cheapest to prepare.
+            let m = Method::Bvh2(Bvh2Method::Stack);
+            (PreparedScene::new(&named.scene, bvh, &[m]).map_err(|e| e.to_string())?, m)
+        }
+        None => {
+            let (candidates, _) = timed("preparing the candidates of --method auto", || {
+                raytrail::analysis::prepare_candidates(&named.scene, bvh)
+            });
+            let (chosen, _) = timed("choosing on a sample of the rays", || {
+                raytrail::analysis::choose_and_keep(&backend, candidates.map_err(|e| e.to_string())?, &rays, query)
+                    .map_err(|e| e.to_string())
+            });
+            let (prepared, choice) = chosen?;
+            eprintln!(
+                "auto: {} (of {}; {} sample rays, {:.2} ms)",
+                choice.method,
+                choice.timed.iter().map(|t| t.method.name()).collect::<Vec<_>>().join(", "),
+                raytrail::analysis::sample::sample_size(rays.len()),
+                1e3 * choice.cost_seconds
+            );
+            (prepared, choice.method)
+        }
+    };
     let scene = backend.prepare(Arc::new(prepared)).map_err(|e| e.to_string())?;
-    let opts = TraceOptions::new(method)
-        .query(if a.any { Query::Any } else { Query::Closest })
-        .triangle_test(if a.moller_trumbore { TriangleTestKind::MollerTrumbore } else { TriangleTestKind::Watertight });
+    let opts = TraceOptions::new(method).query(query).triangle_test(if a.moller_trumbore {
+        TriangleTestKind::MollerTrumbore
+    } else {
+        TriangleTestKind::Watertight
+    });
     let mut hits = try_vec(rays.len(), Hit::MISS, "hits")?;
     let report = backend.trace(&scene, &rays, &opts, &mut hits).map_err(|e| e.to_string())?;
     let out = &a.out;

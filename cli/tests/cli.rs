@@ -40,7 +40,7 @@ fn rays_then_trace_matches_the_library() {
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    for method in ["stack", "hash", "hash-resume"] {
+    for method in ["stack", "hash", "hash-resume", "auto"] {
         let out = bin()
             .args(["trace", "--scene"])
             .arg(&scene)

@@ -94,14 +94,14 @@ fn a_trailing_unknown_flag_is_unknown() {
     assert!(err.contains("unexpected argument '--bogus'") && !err.contains("needs a value"), "{err}");
 }
 
-/// `--method` is optional with the default `hash`, and the help says so.
+/// `--method` is optional with the default `auto`, and the help says so.
 #[test]
 fn method_is_optional_with_its_default_shown() {
     let help = text(&run(&["trace", "--help"]).stdout);
     let usage = help.lines().find(|l| l.starts_with("Usage:")).unwrap();
     assert!(!usage.contains("--method"), "{usage}");
     let after = &help[help.find("--method").unwrap()..];
-    assert!(after[..after.find("--out").unwrap()].contains("[default: hash]"), "{help}");
+    assert!(after[..after.find("--out").unwrap()].contains("[default: auto]"), "{help}");
 }
 
 /// Defaults are shown in the help.

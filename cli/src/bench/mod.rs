@@ -19,6 +19,7 @@ pub(crate) mod rays;
 mod report;
 mod table;
 mod target;
+mod target_auto;
 mod target_gpu;
 pub mod view;
 
@@ -96,6 +97,9 @@ pub fn main(a: options::BenchArgs, args: &[String]) -> Outcome {
 /// Fails early when `--baseline` names no target of this run.
 fn check_baseline(opts: &Options) -> Result<(), String> {
     let mut names: Vec<String> = opts.methods.iter().map(|m| m.name().to_string()).collect();
+    if opts.auto {
+        names.push(crate::args::AUTO.to_string());
+    }
     for p in &opts.peers {
         names.extend(peers::target_names(p));
     }
@@ -133,6 +137,10 @@ fn bench_scene(
     if !methods.contains(&Method::Bvh2(Bvh2Method::Stack)) {
         methods.push(Method::Bvh2(Bvh2Method::Stack));
     }
+    // `auto` times its candidates, so their tables must be there.
+    if opts.auto {
+        methods.extend(raytrail::analysis::choice::CANDIDATES.iter().filter(|m| !opts.methods.contains(m)));
+    }
     let (prepared, _) = timed("deriving raytrail's layouts, hash tables and kd-tree", || {
         largest.install(|| PreparedScene::new(scene, bvh, &methods))
     });
@@ -151,6 +159,14 @@ fn bench_scene(
             targets.push(Box::new(RaytrailCpu::new(m, cpu.clone())));
         }
     }
+    let auto_log = if opts.auto {
+        let auto = target_auto::AutoTarget::new(cpu.clone());
+        let log = auto.choices.clone();
+        targets.push(Box::new(auto));
+        Some(log)
+    } else {
+        None
+    };
     targets.extend(gpu_targets(opts, &cpu)?);
     let (built, _) = timed("building the peers' trees", || peers::build(&opts.peers, scene, largest));
     let (peer_targets, peer_builds) = built?;
@@ -195,6 +211,9 @@ fn bench_scene(
             rays.push(plan.run(b, reference, &mut progress)?);
         }
         progress.finish();
+        if let Some(log) = &auto_log {
+            print_auto_choices(&name, log, &rays, pools);
+        }
         let report = SceneReport {
             name,
             view,
@@ -208,6 +227,37 @@ fn bench_scene(
         reports.push(report);
     }
     Ok(reports)
+}
+
+/// Prints (and forgets) the choices `auto` made for a view's batches, each with its cost against
+/// the median time of one `auto` trace of the batch at the same thread count.
+fn print_auto_choices(
+    view: &str,
+    log: &std::sync::Mutex<Vec<(usize, raytrail::analysis::choice::Choice)>>,
+    reports: &[report::RayReport],
+    pools: &[(usize, rayon::ThreadPool)],
+) {
+    let Ok(mut log) = log.lock() else { return };
+    // One choice per batch and thread count, in the order measured (the work pass reuses the
+    // last one).
+    for (i, (n, c)) in log.drain(..).enumerate() {
+        let (report, threads) = (reports.get(i / pools.len().max(1)), pools.get(i % pools.len().max(1)).map(|p| p.0));
+        let report = report.filter(|r| r.rays == n);
+        let batch_s = report
+            .and_then(|r| r.rows.iter().find(|row| row.target == crate::args::AUTO && Some(row.threads) == threads))
+            .map_or(f64::NAN, |row| row.median_s);
+        let kind = report.map_or("?", |r| r.kind.name());
+        println!(
+            "  auto [{view}, {kind}, {} thr]: {} on a {}-ray sample; choosing took {:.2} ms = {:.1}% of one trace of \
+             the batch; {}",
+            threads.unwrap_or(0),
+            c.method,
+            raytrail::analysis::sample::sample_size(n),
+            1e3 * c.cost_seconds,
+            100.0 * c.cost_seconds / batch_s,
+            c.summary()
+        );
+    }
 }
 
 /// raytrail's build steps and the memory of each part it derived.

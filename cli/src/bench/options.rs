@@ -2,7 +2,7 @@
 
 use super::rays::RayKind;
 use super::view::ViewChoice;
-use crate::args::{LoadFlags, BUILDERS};
+use crate::args::{LoadFlags, AUTO, BUILDERS};
 use clap::Parser;
 use raytrail::core::method::Method;
 use raytrail::core::stream::{StreamParams, MAX_PACKET};
@@ -46,6 +46,8 @@ pub struct Options {
     pub threads: Vec<usize>,
     /// raytrail methods to measure.
     pub methods: Vec<Method>,
+    /// Whether to measure `auto`: per batch, the method chosen by timing candidates on a sample.
+    pub auto: bool,
     /// Peers to measure (names from [`PEERS`]).
     pub peers: Vec<String>,
     /// Target whose speed the ratio column divides by.
@@ -94,7 +96,8 @@ pub struct BenchArgs {
     /// Thread counts, comma-separated [default: 1 and all]
     #[arg(long, short = 'j', value_name = "N[,N...]")]
     pub threads: Option<String>,
-    /// raytrail methods, comma-separated, or all or none
+    /// raytrail methods, comma-separated (auto: the method chosen per batch on a sample, as a
+    /// target of its own), or all or none
     #[arg(long, value_name = "NAME,...|all|none", default_value = "all")]
     pub methods: String,
     /// Peers, comma-separated (obvhs-bvh2, obvhs-cwbvh, bvh; each also NAME+wt; embree with the
@@ -176,16 +179,19 @@ impl Options {
                     .collect::<Result<_, _>>()?,
             ),
         };
+        // `auto` is a target of its own (the method chosen per batch), not a method.
+        let auto = a.methods != "all" && a.methods != "none" && list(&a.methods).iter().any(|n| n == AUTO);
         let methods = match a.methods.as_str() {
             "all" => Method::ALL.to_vec(),
             "none" => Vec::new(),
             v => unique(
                 list(v)
                     .iter()
+                    .filter(|n| *n != AUTO)
                     .map(|n| {
                         Method::from_name(n).ok_or_else(|| {
                             format!(
-                                "--methods: unknown method '{n}' (known: {})",
+                                "--methods: unknown method '{n}' (known: {}, {AUTO})",
                                 Method::ALL.map(Method::name).join(", ")
                             )
                         })
@@ -210,7 +216,7 @@ impl Options {
                 given
             }
         };
-        if rays.is_empty() || (methods.is_empty() && peers.is_empty()) {
+        if rays.is_empty() || (methods.is_empty() && !auto && peers.is_empty()) {
             return Err("nothing to measure: give at least one ray type and one method or peer".to_string());
         }
         let (width, height) = (a.width, a.height);
@@ -248,6 +254,7 @@ impl Options {
         let baseline = match (a.baseline.as_deref(), methods.first()) {
             (Some(b), _) => b.to_string(),
             (None, Some(first)) if peers.is_empty() => first.name().to_string(),
+            (None, None) if peers.is_empty() => AUTO.to_string(),
             (None, _) => "obvhs-bvh2".to_string(),
         };
         let stream = stream_params(a.stream_packet.as_deref(), a.stream_cell.as_deref())?;
@@ -258,6 +265,7 @@ impl Options {
         Ok(Options {
             gpu,
             gpu_warm_up: std::time::Duration::from_secs_f64(a.gpu_warm_up),
+            auto,
             stream,
             scenes,
             rays,
@@ -373,6 +381,20 @@ mod tests {
 
     fn parse(s: &str) -> Result<Options, String> {
         Options::parse(&s.split_whitespace().map(str::to_string).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn auto_is_a_target_of_its_own() {
+        assert!(!parse("").unwrap().auto, "`all` is the fixed methods");
+        let o = parse("--methods stack,auto,bvh8 --peers none").unwrap();
+        assert!(o.auto);
+        assert_eq!(o.methods, vec![Method::from_name("stack").unwrap(), Method::from_name("bvh8").unwrap()]);
+        assert_eq!(o.baseline, "stack");
+        let o = parse("--methods auto --peers none").unwrap();
+        assert!(o.auto && o.methods.is_empty());
+        assert_eq!(o.baseline, "auto");
+        let e = parse("--methods automatic").unwrap_err();
+        assert!(e.contains("unknown method 'automatic'") && e.contains(", auto)"), "{e}");
     }
 
     #[test]

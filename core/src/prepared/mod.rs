@@ -4,8 +4,10 @@
 mod enumeration;
 mod frame;
 pub mod normalize;
+mod parts;
 
 pub use frame::{FramedRays, FAR_FACTOR, FAR_LIMIT};
+pub use parts::Part;
 
 use crate::bvh2::traverse::TraceRoot;
 use crate::bvh2::{BinaryLayout, Bvh2, LinkKind, NodeRef, SliceMemory};
@@ -114,7 +116,9 @@ impl PreparedScene {
         let tris = scene.triangles();
         let mut timings = PrepareTimings::default();
         let t0 = seconds_since(None);
-        let needs_uncles = methods.iter().any(|m| !m.needs_parent_links());
+        // Only the BVH2 methods other than parent/sibling read the uncle layout (and the hash
+        // tables are built over it); a scene traced only by kd, wide or stream methods skips it.
+        let needs_uncles = methods.iter().any(|m| m.bvh2().is_some_and(|b| !b.needs_parent_links()));
         let uncles =
             if needs_uncles { Some(BinaryLayout::new(&bvh, tris, LinkKind::Uncles)) } else { None }.transpose()?;
         let parents = if methods.iter().any(|m| m.needs_parent_links()) {

@@ -113,6 +113,17 @@ impl<const W: usize> WideBvh<W> {
         self.stats
     }
 
+    /// Bytes of everything the traversal reads or reports from: nodes, triangles in leaf order,
+    /// their blocks of four, primitive ids and the canonical ids of nodes and leaves.
+    pub fn bytes(&self) -> usize {
+        core::mem::size_of_val(self.nodes.as_slice())
+            + core::mem::size_of_val(self.triangles.as_slice())
+            + core::mem::size_of_val(self.blocks.as_slice())
+            + core::mem::size_of_val(self.prims.as_slice())
+            + core::mem::size_of_val(self.node_ids.as_slice())
+            + core::mem::size_of_val(self.leaf_ids.as_slice())
+    }
+
     /// The canonical BVH2 id of a recorded reference ([`WideChild::node_ref`]), if it names a node
     /// or leaf of this tree.
     pub fn canonical_id(&self, r: NodeRef) -> Option<u32> {
