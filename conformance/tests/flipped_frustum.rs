@@ -95,10 +95,12 @@ fn caught<const K: usize>() -> usize {
     for set in &sets {
         let reference = closest(&set.rays);
         let mut hits = vec![Hit::MISS; set.rays.len()];
+        // In the scene's frame, as every backend traces (far origins moved up to the scene).
+        let framed = prepared.frame_rays(&set.rays);
         let out = trace_stream::<_, Flipped<K>, Watertight, ReferenceKernel>(
             &Serial,
             &scene,
-            &set.rays,
+            framed.rays(),
             &mut hits,
             Query::Closest,
             &StreamParams::default(),
@@ -106,6 +108,7 @@ fn caught<const K: usize>() -> usize {
             true,
         )
         .expect("trace");
+        framed.finish(&mut hits);
         found += reference.iter().zip(&hits).filter(|(e, g)| !e.same_as(g)).count();
         let ctx = Context { scene: &named.name, ray_set: set.kind.name(), backend: "flipped-frustum" };
         let enumerations = out.enumerations.unwrap_or_default();
