@@ -148,6 +148,17 @@ pub enum Command {
         after_help = AFTER_HELP
     )]
     Explain(ExplainArgs),
+    /// Runs the numerics stress suite and reports, per case, rays agreeing with the exact reference
+    #[command(
+        long_about = "Runs the numerics stress suite: rays at shared vertices and edges of closed meshes, grazing \
+                      and axis-parallel rays, origins up to 1e8 scene diameters away, scenes scaled from 1e-30 to \
+                      1e30 and translated up to 1e7 diameters, subnormal coordinates, tiny triangles beside huge \
+                      ones, and the edges of the supported range (docs/NUMERICS-RANGE.md). Every method traces \
+                      every case on the CPU (and on the GPU when wgpu finds an adapter), and every ray is judged \
+                      against an exact reference. Exit status 1 when any ray disagrees.",
+        after_help = AFTER_HELP
+    )]
+    Stress(StressArgs),
     /// Renders the scene to a PNG: normals, ambient occlusion, or a heat map of traversal work
     ///
     /// Primary rays in raster order through the outside or inside camera; the image shows the hit
@@ -344,6 +355,14 @@ pub struct TraceArgs {
     pub max_rays: u64,
     #[command(flatten)]
     pub load: LoadFlags,
+}
+
+/// `raytrail stress`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct StressArgs {
+    /// Leave the GPU out even when wgpu finds an adapter
+    #[arg(long)]
+    pub no_gpu: bool,
 }
 
 /// `raytrail explain`.

@@ -1,5 +1,5 @@
 //! The `raytrail` command line: the main job (no arguments), `trace`, `rays`, `bench`, `render`,
-//! `accuracy` and `explain`. Flags are declared with clap in [`args`]; usage errors exit with status
+//! `accuracy`, `explain` and `stress`. Flags are declared with clap in [`args`]; usage errors exit with status
 //! 2, failures while working with status 1.
 
 mod accuracy;
@@ -12,6 +12,7 @@ mod median;
 mod progress;
 mod render;
 mod run;
+mod stress;
 mod trace;
 
 use args::{Cli, Command};
@@ -32,6 +33,7 @@ fn main() {
         Some(Command::Render(a)) => render::main(a),
         Some(Command::Accuracy(a)) => accuracy::main(a, &raw[2.min(raw.len())..]),
         Some(Command::Explain(a)) => explain::main(a),
+        Some(Command::Stress(a)) => stress::main(a),
     };
     match result {
         Ok(0) => {}

@@ -207,6 +207,16 @@ pub fn all_cases() -> Result<Vec<StressCase>, String> {
     }
     let big: Vec<Triangle> = teapot.iter().map(|t| Triangle { v: t.v.map(|p| p * 1e11) }).collect();
     out.push(StressCase::new("teapot scaled by 1e11", big.clone(), from_afar(&big, c * 1e11, size * 1e11, 2.0, 900)));
+    // The camera's rays (unit directions) into the teapot at 1e37 and 1e-40: `raytrail rays` wrote
+    // NaN directions there, and at 1e37 the unit directions, scaled with their origins, were
+    // refused as unreliable.
+    for (scale, name) in [(1e37f32, "teapot at 1e37, camera rays"), (1e-40, "teapot at 1e-40, camera rays")] {
+        let scaled: Vec<Triangle> = teapot.iter().map(|t| Triangle { v: t.v.map(|p| p * scale) }).collect();
+        if let Some(bounds) = scaled.iter().map(Triangle::bounds).reduce(raytrail_core::Aabb::union) {
+            let camera = crate::rays::primary_from(&crate::rays::Camera::framing(bounds), 16, 16);
+            out.push(StressCase::new(name, scaled, camera));
+        }
+    }
     Ok(out)
 }
 
