@@ -13,6 +13,7 @@ mod progress;
 mod render;
 mod run;
 mod stress;
+mod svg;
 mod trace;
 
 use args::{Cli, Command};

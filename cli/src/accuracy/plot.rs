@@ -4,6 +4,7 @@
 //! Pareto front filled and joined by a line, the default ringed.
 
 use super::report::{AccuracyReport, RaySetReport};
+use crate::svg::escape;
 use raytrail::core::method::{Method, Structure};
 use std::fmt::Write;
 
@@ -32,13 +33,9 @@ fn colour(method: &str) -> &'static str {
     }
 }
 
-/// Escapes text for SVG.
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
-}
-
 fn text(svg: &mut String, x: f64, y: f64, anchor: &str, size: f64, s: &str) {
-    let _ = write!(svg, r#"<text x="{x:.1}" y="{y:.1}" text-anchor="{anchor}" font-size="{size}">{}</text>"#, esc(s));
+    let _ =
+        write!(svg, r#"<text x="{x:.1}" y="{y:.1}" text-anchor="{anchor}" font-size="{size}">{}</text>"#, escape(s));
 }
 
 /// A marker: circle for watertight, triangle otherwise; filled on the front.
@@ -77,7 +74,7 @@ pub fn to_svg(r: &AccuracyReport) -> String {
     let _ = write!(
         svg,
         r#"<text x="10" y="18" font-size="13" font-weight="bold">{}</text>"#,
-        esc(&format!(
+        escape(&format!(
             "raytrail accuracy: Mrays/s (median of {} passes, {} threads, CPU) against the share of sampled rays \
              answered wrongly (exact reference)",
             r.passes, r.threads
@@ -178,7 +175,7 @@ fn chart(svg: &mut String, x0: f64, y0: f64, scene: &str, set: &RaySetReport, lo
                 y - 6.0,
                 x + 5.0,
                 y - 6.0,
-                esc(&label)
+                escape(&label)
             );
         }
     }

@@ -4,6 +4,7 @@
 use super::report::{BenchReport, RayReport, SceneReport};
 use super::table::thousands;
 use super::target::TargetKind;
+use crate::svg::escape;
 use std::fmt::Write;
 
 /// Width of the target-name column.
@@ -233,11 +234,6 @@ fn text(svg: &mut String, x: f64, y: f64, anchor: &str, size: f64, bold: bool, s
         r##"<text x="{x:.1}" y="{y:.1}" text-anchor="{anchor}" font-size="{size}"{weight}>{}</text>"##,
         escape(s)
     );
-}
-
-/// `s` with the XML special characters escaped.
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
 #[cfg(test)]
