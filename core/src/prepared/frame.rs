@@ -261,10 +261,10 @@ impl PreparedScene {
     /// The batch `rays` in this scene's frame (see the module docs); borrows the rays where none
     /// needs a change.
     pub fn frame_rays<'a>(&self, rays: &'a [Ray]) -> FramedRays<'a> {
-        let frame = self.frame();
-        if rays.iter().all(|r| frame.keeps(r)) {
+        if !self.needs_framing(rays) {
             return FramedRays { rays: Cow::Borrowed(rays), fixes: Vec::new() };
         }
+        let frame = self.frame();
         let (fixes, out): (Vec<Fix>, Vec<Ray>) = rays.iter().map(|r| frame.decide(r)).unzip();
         FramedRays { rays: Cow::Owned(out), fixes }
     }
