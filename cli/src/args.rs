@@ -260,11 +260,6 @@ impl LoadFlags {
 /// The BVH2 builders by command-line name.
 pub const BUILDERS: [&str; 2] = ["sah", "ploc"];
 
-/// The method names, for `--method`.
-pub fn method_names() -> PossibleValuesParser {
-    PossibleValuesParser::new(Method::ALL.map(Method::name))
-}
-
 /// The name that asks for the method to be chosen by timing candidates on a sample of the rays
 /// (`raytrail::analysis`).
 pub const AUTO: &str = "auto";
@@ -454,8 +449,9 @@ pub struct RenderArgs {
     /// Camera: outside (framing the scene) or inside (low in its box, looking along the long side)
     #[arg(long, default_value = "outside", value_parser = ["outside", "inside"])]
     pub camera: String,
-    /// Traversal method
-    #[arg(long, short = 'm', default_value = "stack", value_parser = method_names(), hide_possible_values = true)]
+    /// Traversal method, or auto: the fastest of a few candidates timed on a sample of the image's
+    /// rays
+    #[arg(long, short = 'm', default_value = "stack", value_parser = method_names_or_auto(), hide_possible_values = true)]
     pub method: String,
     /// Backend for normals and ao: cpu, or gpu (wgpu, when it finds an adapter); heat maps run on
     /// the CPU

@@ -4,6 +4,7 @@
 
 mod accuracy;
 mod args;
+mod auto;
 mod bench;
 mod explain;
 mod gpu;

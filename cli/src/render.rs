@@ -3,7 +3,7 @@
 //! triangles' normals, ambient occlusion, or a heat map of the traversal work per pixel (nodes
 //! visited by `--method`, from its per-ray node enumeration), so methods can be compared by eye.
 
-use crate::args::{builder, check_input, check_output, load_scene, method, warn, Outcome, RenderArgs};
+use crate::args::{builder, check_input, check_output, load_scene, method_or_auto, warn, Outcome, RenderArgs};
 use crate::bench::rays::{facing_normal, AoShape};
 use crate::bench::view::View;
 use crate::limits::{check_image, try_vec};
@@ -12,7 +12,6 @@ use crate::trace::raster_rays;
 use glam::Vec3;
 use raytrail::conformance::rng::Pcg32;
 use raytrail::core::method::{Method, Query};
-use raytrail::core::prepared::PreparedScene;
 use raytrail::core::scene::Scene;
 use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
@@ -36,7 +35,7 @@ pub fn main(a: RenderArgs) -> Outcome {
     let per_pixel = (std::mem::size_of::<Ray>() + std::mem::size_of::<Hit>() + 3) as u64;
     let pixels = check_image(width, height, "pixels", "max-pixels", a.max_pixels, per_pixel)? as usize;
     check_input("scene", &a.scene)?;
-    let method = method(&a.method);
+    let method = method_or_auto(&a.method);
     let heat = a.mode == "heat" || a.mode == "backtracks";
     if heat && a.backend == "gpu" {
         return crate::args::usage(format!(
@@ -53,14 +52,15 @@ pub fn main(a: RenderArgs) -> Outcome {
         builder(&a.builder).build(scene)
     });
     let bvh = bvh.map_err(|e| e.to_string())?;
-    let (prepared, _) = timed("deriving the method's layouts", || PreparedScene::new(scene, bvh, &[method]));
-    let prepared = Arc::new(prepared.map_err(|e| e.to_string())?);
     let view = if a.camera == "inside" { View::Inside } else { View::Outside };
     let camera = view.camera(scene.bounds());
     let rays = raster_rays(&camera, width, height);
     debug_assert_eq!(rays.len(), pixels);
 
     let cpu_backend = CpuBackend::new();
+    // Auto chooses for the image's own rays, as `trace` does for its file's.
+    let (prepared, method) = crate::auto::prepare_for(scene, bvh, method, &rays, Query::Closest, &cpu_backend)?;
+    let prepared = Arc::new(prepared);
     let cpu = cpu_backend.prepare(prepared.clone()).map_err(|e| e.to_string())?;
     let image = if heat {
         let what = if a.mode == "heat" { "nodes visited" } else { "backtracking steps" };

@@ -6,8 +6,7 @@ use crate::limits::{check_count, check_image, try_vec};
 use crate::progress::timed;
 use raytrail::conformance::rays::{primary_from, Camera};
 use raytrail::core::mesh::LoadOptions;
-use raytrail::core::method::{Bvh2Method, Method, Query};
-use raytrail::core::prepared::PreparedScene;
+use raytrail::core::method::Query;
 use raytrail::core::trace::{Trace, TraceOptions, TriangleTestKind};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::CpuBackend;
@@ -44,32 +43,7 @@ pub fn main(a: TraceArgs) -> Outcome {
     let bvh = bvh.map_err(|e| e.to_string())?;
     let backend = CpuBackend::new();
     let query = if a.any { Query::Any } else { Query::Closest };
-    let (prepared, method) = match method {
-        Some(m) => (PreparedScene::new(&named.scene, bvh, &[m]).map_err(|e| e.to_string())?, m),
-        None if rays.is_empty() => {
-            // Nothing to sample: any method traces no rays alike; the cheapest to prepare.
-            let m = Method::Bvh2(Bvh2Method::Stack);
-            (PreparedScene::new(&named.scene, bvh, &[m]).map_err(|e| e.to_string())?, m)
-        }
-        None => {
-            let (candidates, _) = timed("preparing the candidates of --method auto", || {
-                raytrail::analysis::prepare_candidates(&named.scene, bvh)
-            });
-            let (chosen, _) = timed("choosing on a sample of the rays", || {
-                raytrail::analysis::choose_and_keep(&backend, candidates.map_err(|e| e.to_string())?, &rays, query)
-                    .map_err(|e| e.to_string())
-            });
-            let (prepared, choice) = chosen?;
-            eprintln!(
-                "auto: {} (of {}; {} sample rays, {:.2} ms)",
-                choice.method,
-                choice.timed.iter().map(|t| t.method.name()).collect::<Vec<_>>().join(", "),
-                raytrail::analysis::sample::sample_size(rays.len()),
-                1e3 * choice.cost_seconds
-            );
-            (prepared, choice.method)
-        }
-    };
+    let (prepared, method) = crate::auto::prepare_for(&named.scene, bvh, method, &rays, query, &backend)?;
     let scene = backend.prepare(Arc::new(prepared)).map_err(|e| e.to_string())?;
     let opts = TraceOptions::new(method).query(query).triangle_test(if a.moller_trumbore {
         TriangleTestKind::MollerTrumbore

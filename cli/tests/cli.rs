@@ -167,3 +167,29 @@ fn short_faces_lines_and_points_warn_by_default_and_fail_under_strict() {
     assert!(!strict.status.success(), "{err}");
     assert!(err.contains("face has 2 vertices; a face needs at least 3") && !err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn render_with_auto_draws_what_its_chosen_method_draws() {
+    let run = |method: &str, out: &PathBuf| {
+        let o = bin()
+            .args([
+                "render", "--scene", "builtin", "--mode", "heat", "-W", "48", "-H", "32", "--method", method, "--out",
+            ])
+            .arg(out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let auto_png = tmp("auto.png");
+    let told = run("auto", &auto_png);
+    let chosen = told
+        .lines()
+        .find_map(|l| l.strip_prefix("auto: "))
+        .and_then(|l| l.split_whitespace().next())
+        .unwrap_or_else(|| panic!("no choice printed: {told}"))
+        .to_string();
+    let fixed_png = tmp("fixed.png");
+    run(&chosen, &fixed_png);
+    assert_eq!(std::fs::read(&auto_png).unwrap(), std::fs::read(&fixed_png).unwrap(), "auto chose {chosen}");
+}
