@@ -20,7 +20,9 @@ pub use far::{far_from_origin, FAR_CENTER};
 pub use grid::shared_edge_grid;
 pub use soup::triangle_soup;
 pub use sphereflake::sphereflake;
-pub use stack::degenerate_stack;
+pub use stack::{
+    degenerate_stack, DEFAULT_LAYERS as DEGENERATE_STACK_LAYERS, MAX_LAYERS as DEGENERATE_STACK_MAX_LAYERS,
+};
 pub use tiny::tiny_cases;
 
 use raytrail_core::geometry::Triangle;

@@ -11,8 +11,13 @@ pub struct SahConfig {
     pub bins: usize,
     /// Cost of one node traversal step, relative to `intersection_cost`.
     pub traversal_cost: f32,
-    /// Cost of one ray/triangle test.
+    /// Cost of one leaf test: of `leaf_block` triangles at once.
     pub intersection_cost: f32,
+    /// Triangles a leaf test takes at once: a leaf of `n` triangles costs `ceil(n / leaf_block)`
+    /// tests. 4 by default, as the wide BVHs and the stream method test leaves four triangles at
+    /// a time (SIMD lanes), so a leaf of one triangle costs what a leaf of four does; 1 counts
+    /// every triangle (the textbook model).
+    pub leaf_block: u32,
     /// Leaves larger than this are split even when the SAH prefers a leaf.
     pub max_leaf_size: u32,
     /// Depth cap (at most 63, so keys fit in 64 bits); nodes at the cap become leaves.
@@ -21,7 +26,18 @@ pub struct SahConfig {
 
 impl Default for SahConfig {
     fn default() -> Self {
-        Self { bins: 16, traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, max_depth: 63 }
+        // Per triangle, with both costs 1, leaves held 2.25 triangles on Sponza and every block
+        // of four carried empty lanes; costed per block, bvh8 traced the dragon's camera and
+        // diffuse rays 1.35-1.48 times as fast (BENCHMARKS.md, "Leaves costed per block of four").
+        Self { bins: 16, traversal_cost: 1.0, intersection_cost: 1.0, leaf_block: 4, max_leaf_size: 8, max_depth: 63 }
+    }
+}
+
+impl SahConfig {
+    /// Leaf tests a leaf of `n` triangles takes: `ceil(n / leaf_block)` (`leaf_block` at least 1).
+    #[inline]
+    pub fn leaf_tests(&self, n: u32) -> f32 {
+        n.div_ceil(self.leaf_block.max(1)) as f32
     }
 }
 
@@ -57,7 +73,12 @@ impl SahBuilder {
         if triangles.is_empty() {
             return Err(Error::EmptyScene);
         }
-        let cfg = SahConfig { max_depth: self.config.max_depth.min(63), bins: self.config.bins.max(2), ..self.config };
+        let cfg = SahConfig {
+            max_depth: self.config.max_depth.min(63),
+            bins: self.config.bins.max(2),
+            leaf_block: self.config.leaf_block.max(1),
+            ..self.config
+        };
         let bounds: Vec<Aabb> = triangles.iter().map(Triangle::bounds).collect();
         let centroids: Vec<Vec3> = bounds.iter().map(Aabb::center).collect();
         let mut prims: Vec<u32> = (0..triangles.len() as u32).collect();
@@ -78,7 +99,7 @@ impl SahBuilder {
                 nodes[w.slot].kind = leaf;
                 continue;
             }
-            let leaf_cost = cfg.intersection_cost * count as f32;
+            let leaf_cost = cfg.intersection_cost * cfg.leaf_tests(count as u32);
             let best = best_binned_split(range, &bounds, &centroids, cbounds, &cfg, &mut bins, &mut right_area);
             let parent_area = node_bounds.half_area().max(f32::MIN_POSITIVE);
             let mid = match best {
@@ -141,7 +162,8 @@ fn bin_of(c: f32, min: f32, scale: f32, bins: usize) -> usize {
     (((c - min) * scale) as usize).min(bins - 1)
 }
 
-/// The best (axis, first bin of the right side, unnormalized cost `A_l N_l + A_r N_r`).
+/// The best (axis, first bin of the right side, unnormalized cost `A_l T_l + A_r T_r`, `T` the
+/// leaf tests of a side's triangles).
 fn best_binned_split(
     range: &[u32],
     bounds: &[Aabb],
@@ -168,7 +190,7 @@ fn best_binned_split(
         for i in (1..cfg.bins).rev() {
             acc = acc.union(bins[i].bounds);
             n += bins[i].count;
-            right_area[i] = acc.half_area() * n as f32;
+            right_area[i] = acc.half_area() * cfg.leaf_tests(n);
         }
         let (mut acc, mut n) = (Aabb::EMPTY, 0u32);
         for i in 1..cfg.bins {
@@ -177,7 +199,7 @@ fn best_binned_split(
             if n == 0 || n as usize == range.len() {
                 continue;
             }
-            let cost = acc.half_area() * n as f32 + right_area[i];
+            let cost = acc.half_area() * cfg.leaf_tests(n) + right_area[i];
             if best.is_none_or(|(_, _, c)| cost < c) {
                 best = Some((axis, i, cost));
             }
@@ -225,6 +247,18 @@ mod tests {
         let t = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
         let bvh = SahBuilder::default().build(&alloc::vec![t; 100]).unwrap();
         assert!(bvh.stats().max_leaf_size <= 8);
+    }
+
+    #[test]
+    fn leaves_costed_per_block_fill_their_blocks() {
+        let tris = grid(40);
+        let build = |leaf_block| SahBuilder::new(SahConfig { leaf_block, ..SahConfig::default() }).build(&tris);
+        let (per_triangle, per_block) = (build(1).unwrap().stats(), build(4).unwrap().stats());
+        let mean = |s: &crate::bvh2::TreeStats| tris.len() as f64 / s.leaves as f64;
+        assert!(mean(&per_block) > 1.5 * mean(&per_triangle), "{per_block:?} against {per_triangle:?}");
+        assert!(per_block.max_leaf_size <= 8);
+        assert_eq!(SahConfig { leaf_block: 4, ..SahConfig::default() }.leaf_tests(5), 2.0);
+        assert_eq!(SahConfig { leaf_block: 0, ..SahConfig::default() }.leaf_tests(5), 5.0, "0 counts as 1");
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! enumerations equal those of `trace_ray` ray by ray, for every method, key width and warp width.
 
 use raytrail_conformance::rays::{adversarial, uniform_random, RAY_SEED};
-use raytrail_conformance::scenes::{degenerate_stack, sphereflake, SCENE_SEED};
+use raytrail_conformance::scenes::{degenerate_stack, sphereflake, DEGENERATE_STACK_LAYERS, SCENE_SEED};
 use raytrail_core::bvh2::traverse::trace_ray;
 use raytrail_core::intersect::Watertight;
 use raytrail_core::key::{Key, KeyWidth};
@@ -73,7 +73,7 @@ fn lockstep_matches_trace_ray_for_odd_warps_and_adversarial_rays() {
 
 #[test]
 fn sixty_four_bit_keys_are_simulated_too() {
-    let s = Scenario::new(degenerate_stack(48, SCENE_SEED), RayKind::Primary, 16, 12).unwrap();
+    let s = Scenario::new(degenerate_stack(DEGENERATE_STACK_LAYERS, SCENE_SEED), RayKind::Primary, 16, 12).unwrap();
     assert_eq!(s.prepared.key_width(), KeyWidth::W64);
     let mut rays = s.rays.clone();
     rays.extend(uniform_random(&s.scene, 100, RAY_SEED));
