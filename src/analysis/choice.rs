@@ -148,11 +148,8 @@ pub fn choose(candidates: &[Method], rounds: usize, clock: &mut dyn SampleClock)
         cost += s;
         timed.push(Timed { method, first: sane(s), seconds: Vec::new(), dropped: false });
     }
-    let fastest = timed.iter().map(|t| t.first).fold(f64::INFINITY, f64::min);
-    for t in &mut timed {
-        t.dropped = t.first > PRUNE_FACTOR * fastest;
-    }
-    let mut left: Vec<usize> = (0..timed.len()).filter(|&i| !timed[i].dropped).collect();
+    let mut left: Vec<usize> = (0..timed.len()).collect();
+    drop_slower(&mut timed, &mut left, PRUNE_FACTOR, |t| t.first);
     if left.len() > 1 {
         for round in 0..rounds {
             for &i in &left {
@@ -161,11 +158,7 @@ pub fn choose(candidates: &[Method], rounds: usize, clock: &mut dyn SampleClock)
                 timed[i].seconds.push(sane(s));
             }
             if round == 0 {
-                let fastest = left.iter().map(|&i| timed[i].seconds[0]).fold(f64::INFINITY, f64::min);
-                for &i in &left {
-                    timed[i].dropped = timed[i].seconds[0] > ROUND_PRUNE_FACTOR * fastest;
-                }
-                left.retain(|&i| !timed[i].dropped);
+                drop_slower(&mut timed, &mut left, ROUND_PRUNE_FACTOR, |t| t.seconds[0]);
                 if left.len() == 1 {
                     break;
                 }
@@ -180,6 +173,16 @@ pub fn choose(candidates: &[Method], rounds: usize, clock: &mut dyn SampleClock)
         }
     }
     Ok(Choice { method: timed[best].method, timed, cost_seconds: cost })
+}
+
+/// Marks dropped, and removes from `left`, the candidates whose `time` exceeds `factor` times the
+/// fastest of `left`.
+fn drop_slower(timed: &mut [Timed], left: &mut Vec<usize>, factor: f64, time: impl Fn(&Timed) -> f64) {
+    let fastest = left.iter().map(|&i| time(&timed[i])).fold(f64::INFINITY, f64::min);
+    for &i in left.iter() {
+        timed[i].dropped = time(&timed[i]) > factor * fastest;
+    }
+    left.retain(|&i| !timed[i].dropped);
 }
 
 /// A clock reading that cannot win: NaN and negative times become infinite.

@@ -4,16 +4,19 @@
 use super::scene_of;
 use crate::rng::Pcg32;
 use glam::Vec3;
-use raytrail_core::bvh2::SahConfig;
 use raytrail_core::geometry::Triangle;
 use raytrail_core::scene::Scene;
+
+/// Layers per group: the SAH builder's default leaf block ([`SahConfig::leaf_block`](raytrail_core::bvh2::SahConfig::leaf_block); a test
+/// checks the depth this gives).
+const GROUP: usize = 4;
 
 /// Layers of the suite's stack: the SAH tree is `(layers - 8) / 4` deep (40), past the 31 levels
 /// of 32-bit keys and well inside the 63 of 64-bit ones.
 pub const DEFAULT_LAYERS: usize = 168;
 
 /// Most layers: a tree of depth 63.
-pub const MAX_LAYERS: usize = 8 + 4 * 63;
+pub const MAX_LAYERS: usize = 8 + GROUP * 63;
 
 /// Gap between the two lowest groups of layers. The stack is at most 8 such gaps thick (2^-57),
 /// far below `f32::EPSILON` relative to its unit extent in y and z, so every box's surface area
@@ -32,7 +35,7 @@ const LAYER_SPACING: f64 = 1.0 / 64.0;
 ///
 /// Why it is deep: every box of the stack spans `[0, 1]` in y and z and less than 2^-57 in x, so
 /// all surface areas are exactly 1, and a split's SAH cost is the number of four-triangle leaf
-/// tests of its two sides (the builder's default [`SahConfig::leaf_block`]). Splitting off one
+/// tests of its two sides (the builder's default [`SahConfig::leaf_block`](raytrail_core::bvh2::SahConfig::leaf_block)). Splitting off one
 /// group of four costs the least any split can, so the binned builder takes it when it is the
 /// first candidate: the gaps between groups shrink by 7/8 from the bottom up, so the lowest group
 /// always lies in bin 0, alone. Each split peels off one group, down to the 8-triangle leaf.
@@ -42,15 +45,14 @@ const LAYER_SPACING: f64 = 1.0 / 64.0;
 /// Panics if `layers` is 0 or over [`MAX_LAYERS`] (the builder caps depth at 63).
 pub fn degenerate_stack(layers: usize, seed: u64) -> Scene {
     assert!((1..=MAX_LAYERS).contains(&layers), "degenerate_stack: layers must be in 1..={MAX_LAYERS}, got {layers}");
-    let group = SahConfig::default().leaf_block.max(1) as usize;
     let mut tris = Vec::with_capacity(layers);
     let (mut p, mut gap) = (0.0f64, FIRST_GAP);
     for m in 0..layers {
-        let x = (p + (m % group) as f64 * LAYER_SPACING * gap) as f32;
+        let x = (p + (m % GROUP) as f64 * LAYER_SPACING * gap) as f32;
         let (a, b, c) = (Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0));
         // Alternate the winding so front and back faces both occur.
         tris.push(if m % 2 == 0 { Triangle::new(a, b, c) } else { Triangle::new(a, c, b) });
-        if m % group == group - 1 {
+        if m % GROUP == GROUP - 1 {
             p += gap;
             gap *= GAP_RATIO;
         }
@@ -70,7 +72,8 @@ mod tests {
         let scene = degenerate_stack(DEFAULT_LAYERS, 1);
         let stats = SahBuilder::default().build(scene.triangles()).unwrap().stats();
         assert!(stats.depth > 31 && stats.depth <= 63, "depth {}", stats.depth);
-        assert_eq!(stats.depth as usize, (DEFAULT_LAYERS - 8) / 4);
+        assert_eq!(stats.depth as usize, (DEFAULT_LAYERS - 8) / GROUP);
+        assert_eq!(GROUP as u32, raytrail_core::bvh2::SahConfig::default().leaf_block);
         assert_eq!(stats.key_width, KeyWidth::W64);
     }
 
