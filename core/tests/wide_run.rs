@@ -1,0 +1,97 @@
+//! The wide traversal's one-loop form (`WideState::run`, what every batch traces with) against its
+//! state machine driven step by step (`WideState::step`, what the simulator and the embedded
+//! example drive): the same answer and the same events, ray for ray, also when the step budget
+//! cuts a ray short.
+
+use raytrail_core::bvh2::NodeRef;
+use raytrail_core::bvh2::{SahBuilder, SahConfig};
+use raytrail_core::intersect::{NoPair, Watertight};
+use raytrail_core::method::{Collapse, Query};
+use raytrail_core::observe::{Backtrack, Counters, Observer};
+use raytrail_core::traverse::{begin, Step};
+use raytrail_core::wide::traverse::{WideRoot, WideState};
+use raytrail_core::wide::{FastKernel, ReferenceKernel, WideBvh};
+use raytrail_core::Ray;
+
+mod common;
+use common::{soup, Rng};
+
+/// Every event, in order.
+#[derive(Debug, Default, PartialEq)]
+struct Events {
+    counters: Counters,
+    log: Vec<(u8, u32, u32)>,
+}
+
+impl Observer for Events {
+    fn node(&mut self, n: NodeRef) {
+        self.counters.node(n);
+        self.log.push((0, n.0, 0));
+    }
+    fn primitive(&mut self, p: u32) {
+        self.counters.primitive(p);
+        self.log.push((1, p, 0));
+    }
+    fn hit(&mut self, p: u32, t: f32) {
+        self.counters.hit(p, t);
+        self.log.push((2, p, t.to_bits()));
+    }
+    fn backtrack(&mut self, levels: u32, via: Backtrack) {
+        self.counters.backtrack(levels, via);
+        self.log.push((3, levels, 0));
+    }
+}
+
+/// Rays from around and inside the soup in every direction, some axis-parallel.
+fn rays(n: usize, seed: u64) -> Vec<Ray> {
+    let mut r = Rng(seed);
+    (0..n)
+        .map(|i| {
+            let o = r.v() * 14.0 - 2.0;
+            let mut d = r.v() - 0.5;
+            if i % 7 == 0 {
+                d = glam::Vec3::new(0.0, d.y, 0.0);
+            }
+            Ray::new(o, d, 0.0, if i % 3 == 0 { 5.0 } else { f32::INFINITY })
+        })
+        .collect()
+}
+
+fn compare<const W: usize, K: raytrail_core::wide::ChildKernel>(wide: &WideBvh<W>, scale: f32, max_steps: u32) -> u64 {
+    let mem = wide.memory();
+    let root = WideRoot { root: wide.root(), scene_scale: scale, max_steps };
+    let mut visited = 0;
+    for (i, ray) in rays(1500, 11 + W as u64).iter().enumerate() {
+        let query = if i % 2 == 0 { Query::Closest } else { Query::Any };
+        let Some((ctx, q0)) = begin::<Watertight, NoPair>(ray, scale, query) else { continue };
+        let (mut q_step, mut q_run) = (q0, q0);
+        let (mut e_step, mut e_run) = (Events::default(), Events::default());
+        let mut state = WideState::<W>::new(root.root);
+        let mut budget = max_steps;
+        while state.step::<_, Watertight, K, _>(&mem, &ctx, &mut q_step, &mut e_step) != Step::Done && budget > 0 {
+            budget -= 1;
+        }
+        WideState::<W>::new(root.root).run::<_, Watertight, K, _>(&mem, root, &ctx, &mut q_run, &mut e_run);
+        let bits = |h: raytrail_core::Hit| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits());
+        assert_eq!(bits(q_run.hit), bits(q_step.hit), "ray {i}: {ray:?}");
+        assert_eq!(e_run, e_step, "ray {i}: {ray:?}");
+        visited += e_run.counters.internal_nodes + e_run.counters.leaves;
+    }
+    visited
+}
+
+#[test]
+fn run_equals_stepping_the_state_machine() {
+    let tris = soup(4000, 5, 1.5);
+    let scale = tris.iter().flat_map(|t| t.v).map(|v| v.abs().max_element()).fold(0.0, f32::max);
+    let bvh = SahBuilder::new(SahConfig::default()).build(&tris).unwrap();
+    let w4 = WideBvh::<4>::build(&bvh, &tris, Collapse::PullUp).unwrap();
+    let w8 = WideBvh::<8>::build(&bvh, &tris, Collapse::PullUp).unwrap();
+    for max_steps in [u32::MAX, 0, 1, 3, 10] {
+        let visited = compare::<4, FastKernel>(&w4, scale, max_steps)
+            + compare::<8, FastKernel>(&w8, scale, max_steps)
+            + compare::<8, ReferenceKernel>(&w8, scale, max_steps);
+        // The rays do reach into the tree (a budget of 0 still visits each root).
+        assert!(visited > 3 * 1000, "budget {max_steps}: only {visited} nodes visited");
+    }
+}

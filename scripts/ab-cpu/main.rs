@@ -1,0 +1,163 @@
+//! The harness of `scripts/ab-cpu.sh` (see there): the same rays through an old commit's CPU
+//! backend (`oc`, `ocpu`) and the working tree's (`rc`, `rcpu`), one thread, interleaved rounds.
+//!
+//! Rays: primary rays of the bench's outside or inside view (the inside camera below is the
+//! bench's, `cli/src/bench/view.rs`), their diffuse bounces, shadow rays to the default light,
+//! and ambient-occlusion rays (the bounces cut to 5% of the scene's diagonal).
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The bench's inside camera: low in the box, looking along its longer horizontal side.
+fn inside_camera(b: rc::Aabb) -> conf::rays::Camera {
+    let (min, e) = (b.min, b.extent());
+    let ea = e.to_array();
+    let shortest = if ea[0] < ea[2] { 0 } else { 2 };
+    let up = if ea[shortest] < 0.5 * ea[1] { shortest } else { 1 };
+    let (a, bb) = match up {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    let fwd = if e[bb] > e[a] { bb } else { a };
+    let mut eye = b.center();
+    eye[up] = min[up] + 0.25 * e[up];
+    let mut target = eye;
+    target[fwd] += e[fwd].max(1.0);
+    let mut u = glam::Vec3::ZERO;
+    u[up] = 1.0;
+    conf::rays::Camera { eye, target, up: u, tan_half_vfov: 1.0 }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let path = &args[1];
+    let view = args.get(2).map(String::as_str).unwrap_or("inside");
+    let method = args.get(3).map(String::as_str).unwrap_or("bvh8").to_string();
+    let rounds: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(15);
+    let sets_wanted: Vec<String> = args.get(5).map(|s| s.split(',').map(String::from).collect()).unwrap_or(vec![
+        "primary".into(),
+        "shadow".into(),
+        "diffuse".into(),
+        "ao".into(),
+    ]);
+    let (w, h): (u32, u32) = std::env::var("AB_SIZE")
+        .ok()
+        .and_then(|s| {
+            let (a, b) = s.split_once("x")?;
+            Some((a.parse().ok()?, b.parse().ok()?))
+        })
+        .unwrap_or((384, 288));
+
+    // New side.
+    let mesh = rc::mesh::load(Path::new(path)).unwrap();
+    let scene = mesh.to_scene().unwrap();
+    let mut cfg = rc::bvh2::SahConfig::default();
+    let envf = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f32>().ok());
+    if let Some(t) = envf("AB_TRAV") {
+        cfg.traversal_cost = t;
+    }
+    if let Some(t) = envf("AB_MAXLEAF") {
+        cfg.max_leaf_size = t as u32;
+    }
+    if let Some(t) = envf("AB_BLOCK") {
+        cfg.leaf_block = t as u32;
+    }
+    if let Some(t) = envf("AB_BINS") {
+        cfg.bins = t as usize;
+    }
+    let bvh = rc::bvh2::SahBuilder { config: cfg }.build(scene.triangles()).unwrap();
+    eprintln!("new tree: {:?}", bvh.stats());
+    let m = rc::method::Method::from_name(&method).unwrap();
+    let prepared = Arc::new(rc::prepared::PreparedScene::new(&scene, bvh, &[m]).unwrap());
+    let newb = rcpu::CpuBackend::with_threads(1).unwrap();
+    use rc::trace::Trace;
+    let ns = newb.prepare(prepared).unwrap();
+    // Old side.
+    let omesh = oc::mesh::load(Path::new(path)).unwrap();
+    let oscene = omesh.to_scene().unwrap();
+    let obvh = oc::bvh2::SahBuilder::default().build(oscene.triangles()).unwrap();
+    let om = oc::method::Method::from_name(&method).unwrap();
+    let oprepared = Arc::new(oc::prepared::PreparedScene::new(&oscene, obvh, &[om]).unwrap());
+    let oldb = ocpu::CpuBackend::with_threads(1).unwrap();
+    use oc::trace::Trace as OTrace;
+    let os = oldb.prepare(oprepared).unwrap();
+
+    let bounds = scene.bounds();
+    let cam = if view == "inside" { inside_camera(bounds) } else { conf::rays::Camera::framing(bounds) };
+    let prim = conf::rays::primary_from(&cam, w, h);
+    let mut hits = vec![rc::Hit::MISS; prim.len()];
+    newb.trace(&ns, &prim, &rc::trace::TraceOptions::new(m), &mut hits).unwrap();
+    let diff = conf::rays::diffuse(&prim, &hits, &scene, conf::rays::RAY_SEED);
+    let sh = conf::rays::shadow(&prim, &hits, conf::rays::default_light(bounds), conf::rays::scene_epsilon(bounds));
+    let radius = 0.05 * bounds.extent().length();
+    let ao: Vec<rc::Ray> = diff.iter().map(|r| rc::Ray::new(r.origin(), r.dir(), r.tmin, radius)).collect();
+    let all = [("primary", prim, false), ("shadow", sh, true), ("diffuse", diff, false), ("ao", ao, true)];
+    for (name, rays, any) in all.iter() {
+        if !sets_wanted.iter().any(|s| s == name) {
+            continue;
+        }
+        let orays: Vec<oc::Ray> =
+            rays.iter().map(|r| oc::Ray { origin: r.origin, tmin: r.tmin, dir: r.dir, tmax: r.tmax }).collect();
+        let q = if *any { rc::method::Query::Any } else { rc::method::Query::Closest };
+        let oq = if *any { oc::method::Query::Any } else { oc::method::Query::Closest };
+        let nopts = rc::trace::TraceOptions::new(m).query(q);
+        let oopts = oc::trace::TraceOptions::new(om).query(oq);
+        let mut nh = vec![rc::Hit::MISS; rays.len()];
+        let mut oh = vec![oc::Hit::MISS; rays.len()];
+        let (mut tn, mut to) = (Vec::new(), Vec::new());
+        for r in 0..rounds + 1 {
+            let mut run_old = || {
+                let s = Instant::now();
+                oldb.trace(&os, &orays, &oopts, &mut oh).unwrap();
+                s.elapsed().as_secs_f64()
+            };
+            let mut run_new = || {
+                let s = Instant::now();
+                newb.trace(&ns, rays, &nopts, &mut nh).unwrap();
+                s.elapsed().as_secs_f64()
+            };
+            let (a, b) = if r % 2 == 0 {
+                let a = run_old();
+                (a, run_new())
+            } else {
+                let b = run_new();
+                (run_old(), b)
+            };
+            if r > 0 {
+                to.push(a);
+                tn.push(b);
+            }
+        }
+        let cn = newb
+            .trace(&ns, rays, &nopts.clone().record(rc::trace::Record::Counters), &mut nh)
+            .unwrap()
+            .counters
+            .unwrap();
+        let co = oldb
+            .trace(&os, &orays, &oopts.clone().record(oc::trace::Record::Counters), &mut oh)
+            .unwrap()
+            .counters
+            .unwrap();
+        let n = rays.len() as f64;
+        println!(
+            "{name:8} work/ray  old nodes {:.2} leaves {:.2} tests {:.2} | new nodes {:.2} leaves {:.2} tests {:.2}",
+            co.internal_nodes as f64 / n,
+            co.leaves as f64 / n,
+            co.primitive_tests as f64 / n,
+            cn.internal_nodes as f64 / n,
+            cn.leaves as f64 / n,
+            cn.primitive_tests as f64 / n
+        );
+        let same = nh.iter().zip(&oh).all(|(a, b)| a.t.to_bits() == b.t.to_bits() && a.prim == b.prim);
+        let med = |v: &mut Vec<f64>| {
+            v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+            v[v.len() / 2]
+        };
+        let (mo, mn) = (med(&mut to), med(&mut tn));
+        let mut ratios: Vec<f64> = to.iter().zip(&tn).map(|(a, b)| a / b).collect();
+        let mr = med(&mut ratios);
+        println!("{name:8} {:>8} rays  old {:7.2} ms  new {:7.2} ms  new/old speed {:.3} (per-round median {:.3})  same={same}",
+            rays.len(), mo * 1e3, mn * 1e3, mo / mn, mr);
+    }
+}
