@@ -85,7 +85,7 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
         }};
     }
     match method {
-        KdMethod::Stack => drive!(KdStackState::new(t0, t1)),
+        KdMethod::Stack => KdStackState::new(t0, t1).run(mem, &ctx, &mut q, obs, root.max_steps),
         KdMethod::Restart => drive!(KdRestartState::new(t0, t1, RestartPolicy::RESTART)),
         KdMethod::PushDown => drive!(KdRestartState::new(t0, t1, RestartPolicy::PUSH_DOWN)),
         // The packet method went its own way above.

@@ -1,11 +1,13 @@
-//! The wide traversal's one-loop form (`WideState::run`, what every batch traces with) against its
-//! state machine driven step by step (`WideState::step`, what the simulator and the embedded
-//! example drive): the same answer and the same events, ray for ray, also when the step budget
-//! cuts a ray short.
+//! The one-loop forms of the wide and kd-stack traversals (`WideState::run`, `KdStackState::run`:
+//! what the CPU backend traces with) against their state machines driven step by step (`step`:
+//! what the simulator and the embedded example drive): the same answer and the same events, ray
+//! for ray, also when the step budget cuts a ray short.
 
 use raytrail_core::bvh2::NodeRef;
 use raytrail_core::bvh2::{SahBuilder, SahConfig};
-use raytrail_core::intersect::{NoPair, Watertight};
+use raytrail_core::intersect::{KdRayContext, NoPair, Watertight};
+use raytrail_core::kd::traverse::{scene_interval, KdRoot, KdStackState};
+use raytrail_core::kd::{KdBuilder, KdSliceMemory};
 use raytrail_core::method::{Collapse, Query};
 use raytrail_core::observe::{Backtrack, Counters, Observer};
 use raytrail_core::traverse::{begin, Step};
@@ -93,5 +95,38 @@ fn run_equals_stepping_the_state_machine() {
             + compare::<8, ReferenceKernel>(&w8, scale, max_steps);
         // The rays do reach into the tree (a budget of 0 still visits each root).
         assert!(visited > 3 * 1000, "budget {max_steps}: only {visited} nodes visited");
+    }
+}
+
+#[test]
+fn kd_stack_run_equals_stepping_the_state_machine() {
+    let tris = soup(3000, 9, 1.5);
+    let tree = KdBuilder::default().build(&tris).unwrap();
+    let mem = KdSliceMemory { nodes: tree.nodes(), prims: tree.prims(), triangles: &tris };
+    let b = tree.bounds();
+    let scale = b.min.abs().max(b.max.abs()).max_element();
+    let root = KdRoot { lo: b.min, hi: b.max, scene_scale: scale, max_steps: u32::MAX, short_stack: 3 };
+    for max_steps in [u32::MAX, 0, 1, 3, 10] {
+        let mut visited = 0;
+        for (i, ray) in rays(1500, 23).iter().enumerate() {
+            let query = if i % 2 == 0 { Query::Closest } else { Query::Any };
+            let Some((ctx, q0)) = begin::<Watertight, NoPair>(ray, scale, query) else { continue };
+            let ctx: KdRayContext<Watertight> = ctx;
+            let Some((t0, t1)) = scene_interval(&ctx, &root) else { continue };
+            let (mut q_step, mut q_run) = (q0, q0);
+            let (mut e_step, mut e_run) = (Events::default(), Events::default());
+            let mut state = KdStackState::new(t0, t1);
+            let mut budget = max_steps;
+            while state.step(&mem, &ctx, &mut q_step, &mut e_step) != Step::Done && budget > 0 {
+                budget -= 1;
+            }
+            KdStackState::new(t0, t1).run(&mem, &ctx, &mut q_run, &mut e_run, max_steps);
+            let bits = |h: raytrail_core::Hit| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits());
+            assert_eq!(bits(q_run.hit), bits(q_step.hit), "ray {i}: {ray:?}");
+            assert_eq!(e_run, e_step, "ray {i}: {ray:?}");
+            visited += e_run.counters.internal_nodes + e_run.counters.leaves;
+        }
+        // The rays do reach into the tree (a budget of 0 still visits each ray's first node).
+        assert!(visited > 500, "budget {max_steps}: only {visited} nodes visited");
     }
 }
