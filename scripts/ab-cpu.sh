@@ -16,7 +16,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 rev=$1; shift
 old=$(mktemp -d /tmp/raytrail-ab-old.XXXXXX)
 trap 'git -C "$root" worktree remove --force "$old" >/dev/null 2>&1 || true' EXIT
-git -C "$root" worktree add --detach "$old" "$rev" >/dev/null
+git -C "$root" worktree add --quiet --detach "$old" "$rev"
 sed -i 's/^name = "raytrail-core"/name = "raytrail-core-old"/' "$old/core/Cargo.toml"
 sed -i 's/^name = "raytrail-cpu"/name = "raytrail-cpu-old"/' "$old/backends/cpu/Cargo.toml"
 sed -i -E 's|^(raytrail-core = \{ path = "core",[^}]*)\}|\1, package = "raytrail-core-old" }|; s|^(raytrail-cpu = \{ path = "backends/cpu",[^}]*)\}|\1, package = "raytrail-cpu-old" }|' "$old/Cargo.toml"
