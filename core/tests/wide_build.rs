@@ -38,6 +38,23 @@ fn check<const W: usize>(bvh: &Bvh2, wide: &WideBvh<W>) -> Vec<u32> {
                     todo.push(child);
                 }
                 assert!(filled >= 2, "node {n} has {filled} children");
+                // Filled slots first, largest box first.
+                // The same area the builder orders by (the binary node's box is the child's).
+                let area = |i: usize| {
+                    node.child_ref(i).map(|_| {
+                        let (lo, hi) = node.child_box(i);
+                        raytrail_core::Aabb::new(lo, hi).half_area()
+                    })
+                };
+                for i in 1..W {
+                    match (area(i - 1), area(i)) {
+                        (Some(a), Some(b)) => {
+                            assert!(a >= b, "node {n}: slot {i} has a larger box than slot {}", i - 1)
+                        }
+                        (None, Some(_)) => panic!("node {n}: slot {i} filled after an empty slot"),
+                        _ => {}
+                    }
+                }
             }
         }
     }

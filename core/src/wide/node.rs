@@ -7,7 +7,8 @@ use glam::Vec3;
 pub const EMPTY_CHILD: u32 = u32::MAX;
 
 /// A node of a `W`-wide BVH, laid out for testing all children at once: the child boxes as a
-/// structure of arrays (one array of `W` floats per box plane), then the child references.
+/// structure of arrays (one array of `W` floats per box plane), then the child references. The
+/// builder fills the slots from 0, largest box first (the order any-hit queries visit them in).
 ///
 /// Byte layout (`repr(C)`, no padding, `32 W` bytes; the WGSL kernels read it as `8 W` words):
 ///

@@ -238,9 +238,24 @@ impl<const W: usize> Builder<'_, W> {
         }
     }
 
-    /// The canonical nodes that become the children of internal node `n`, in slot order (the
-    /// binary tree's left-to-right order).
+    /// The canonical nodes that become the children of internal node `n`, in slot order: largest
+    /// box first (ties in the binary tree's left-to-right order).
+    ///
+    /// Any-hit queries visit hit children in slot order (Guthe's unsorted occlusion), and the
+    /// surface-area heuristic's estimate of the chance that a ray through a node enters a child
+    /// is the child's box area: the largest box is the likeliest to hold an occluder. Against the
+    /// binary tree's order this cut bvh8's nodes per shadow ray by 5-60% and made shadow rays
+    /// 1.08-1.70 times as fast (BENCHMARKS.md, "Children largest box first"). Closest-hit queries
+    /// sort by entry distance and meet the slot order only in ties.
     fn slots(&self, n: u32) -> Vec<u32> {
+        let mut c = self.slots_in_tree_order(n);
+        // Stable, so equal areas keep the tree's order; areas are finite, so the order is total.
+        c.sort_by(|&a, &b| self.area(b).total_cmp(&self.area(a)));
+        c
+    }
+
+    /// [`Builder::slots`] before ordering: the binary tree's left-to-right order.
+    fn slots_in_tree_order(&self, n: u32) -> Vec<u32> {
         let mut c = self.children(n).map_or_else(Vec::new, |(l, r)| alloc::vec![l, r]);
         match self.collapse {
             Collapse::EverySecondLevel => loop {
