@@ -22,9 +22,10 @@
 pub const REFINE_ULPS: f32 = 256.0;
 
 /// `lhs > REFINE_SCALE * |t * det|` flags a hit: with `lhs` the edge functions' error terms
-/// weighted by the depths (see [`needs_refine`]), the bound is `2ε·lhs/|det| + 8ε|t|`, and
-/// `(REFINE_ULPS - 8) / 2` moves both `ε` factors and the constant part to this side.
-pub(crate) const REFINE_SCALE: f32 = (REFINE_ULPS - 8.0) / 2.0;
+/// weighted by the depths (see `needs_refine` in this module), the bound is
+/// `2ε·lhs/|det| + 8ε|t|`, and `(REFINE_ULPS - 8) / 2` moves both `ε` factors and the constant
+/// part to this side. The wgpu kernels get its bits from here.
+pub const REFINE_SCALE: f32 = (REFINE_ULPS - 8.0) / 2.0;
 
 /// Whether the `f32` hit may be more than [`REFINE_ULPS`] ulps off, to first order.
 ///

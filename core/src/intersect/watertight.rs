@@ -143,7 +143,7 @@ impl TriangleTest for Watertight {
 /// The SSE path of [`Watertight::intersect_block`] (SSE2 is part of the x86_64 baseline).
 #[cfg(target_arch = "x86_64")]
 mod sse {
-    use super::super::refine::REFINE_SCALE;
+    use super::super::REFINE_SCALE;
     use super::{BlockHits, ShearedRay, TriangleBlock, TriangleTest, Watertight};
     use core::arch::x86_64::{
         __m128, _mm_add_ps, _mm_and_ps, _mm_andnot_ps, _mm_cmpeq_ps, _mm_cmpgt_ps, _mm_cmplt_ps, _mm_cmpngt_ps,
