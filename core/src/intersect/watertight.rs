@@ -194,7 +194,10 @@ mod sse {
             let finite = _mm_cmplt_ps(abs_t, splat(f32::INFINITY));
             let det_ok = _mm_andnot_ps(_mm_cmpeq_ps(det, z), _mm_cmpeq_ps(z, z));
             // Hit at a `t` past `tmin`: what the error bound screens, whatever `tmax` is.
-            let ahead = _mm_and_ps(_mm_andnot_ps(_mm_and_ps(neg, pos), det_ok), _mm_and_ps(finite, _mm_cmpnlt_ps(t, splat(tmin))));
+            let ahead = _mm_and_ps(
+                _mm_andnot_ps(_mm_and_ps(neg, pos), det_ok),
+                _mm_and_ps(finite, _mm_cmpnlt_ps(t, splat(tmin))),
+            );
             let ok = _mm_and_ps(ahead, _mm_cmpngt_ps(t, splat(tmax)));
             let zero = _mm_movemask_ps(zero) as u32;
             // The bound only where a lane hits (rare among blocks), so a block of misses pays
@@ -214,10 +217,8 @@ mod sse {
                 };
                 let (eu, ev, ew) = (e(mb, sc, mc, sb), e(mc, sa, ma, sc), e(ma, sb, mb, sa));
                 let dz = |zz: __m128| abs(_mm_sub_ps(zz, t));
-                let lhs = _mm_add_ps(
-                    _mm_add_ps(_mm_mul_ps(eu, dz(az)), _mm_mul_ps(ev, dz(bz))),
-                    _mm_mul_ps(ew, dz(cz)),
-                );
+                let lhs =
+                    _mm_add_ps(_mm_add_ps(_mm_mul_ps(eu, dz(az)), _mm_mul_ps(ev, dz(bz))), _mm_mul_ps(ew, dz(cz)));
                 let rhs = _mm_mul_ps(splat(REFINE_SCALE), abs(_mm_mul_ps(t, det)));
                 slow |= _mm_movemask_ps(_mm_cmpgt_ps(lhs, rhs)) as u32 & screened;
             }
