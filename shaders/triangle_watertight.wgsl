@@ -125,6 +125,10 @@ fn tri_refine(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>) -> TriHit {
     let u = edge64(c[0], c[1], b[0], b[1]);
     let w = edge64(b[0], b[1], a[0], a[1]);
     let v = edge64(a[0], a[1], c[0], c[1]);
+    // The f64 edge functions disagree with the f32 hit: the f32 hit stands (as on the CPU).
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return TriHit(false, 0.0, 0.0, 0.0);
+    }
     let det = (u + v) + w;
     let num = (mul2_64(split64(u), ra.z) + mul2_64(split64(v), rb.z)) + mul2_64(split64(w), rc.z);
     let d = split64(det);

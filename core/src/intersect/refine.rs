@@ -97,6 +97,12 @@ pub(crate) fn refine(origin: [f32; 3], dir: [f32; 3], k: [usize; 3], v: [&[f32; 
     let u = edge(c, b);
     let w_ = edge(b, a);
     let v_ = edge(a, c);
+    // The f32 test decided the ray meets the triangle; where the f64 edge functions disagree (a
+    // ray nearly in the plane), the plane's f64 crossing may lie far outside the triangle and
+    // its box, so the f32 hit stands.
+    if (u < 0.0 || v_ < 0.0 || w_ < 0.0) && (u > 0.0 || v_ > 0.0 || w_ > 0.0) {
+        return None;
+    }
     let det = (u + v_) + w_;
     let num = (mul2(split(u), rel[0][2]) + mul2(split(v_), rel[1][2])) + mul2(split(w_), rel[2][2]);
     let d = split(det);
