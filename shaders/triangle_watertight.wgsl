@@ -69,22 +69,37 @@ fn tri_needs_refine(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, ax: f32, ay: f32, 
     return lhs > bitcast<f32>(REFINE_SCALE_BITS) * abs(t * det);
 }
 
+// `x - 0` with a zero the compiler cannot see (the uniform `P.zero`): exact, the sign of a zero
+// kept, and a wall no algebraic rewrite crosses. Every f64 product of the recomputation goes
+// through it (`xmul`). Exact products alone are not enough: Mesa's compiler (lavapipe) fuses a
+// product into the next addition as an FMA and then factors an operand shared by two products of
+// one sum out of them (`a*b + a*c` into `a*(b + c)`); `b + c` then has more than 24 bits, the
+// product is no longer exact, and the last bit of an edge function moved (one ulp of `v` on the
+// cornell box, enough to flip the sign of a `t` that is exactly 0).
+fn opq64(x: f64) -> f64 {
+    return x - f64(bitcast<f32>(P.zero));
+}
+
+// The exact f64 product of two f32 values, fenced by `opq64`.
+fn xmul(a: f64, b: f64) -> f64 {
+    return opq64(a * b);
+}
+
 // `x` as the sum of two f32 values (`intersect::refine::split`).
 fn split64(x: f64) -> vec2<f64> {
     let hi = f32(x);
     return vec2<f64>(f64(hi), f64(f32(x - f64(hi))));
 }
 
-// Products of split parts only, each exact in f64, so a fused multiply-add rounds as the separate
-// operations do (`mul2`).
+// Products of split parts only, each exact in f64 and fenced (`mul2`).
 fn mul2_64(p: vec2<f64>, q: vec2<f64>) -> f64 {
-    return p.x * q.x + (p.x * q.y + p.y * q.x);
+    return xmul(p.x, q.x) + (xmul(p.x, q.y) + xmul(p.y, q.x));
 }
 
 // `px qy - py qx` of split sheared coordinates (`edge`).
 fn edge64(px: vec2<f64>, py: vec2<f64>, qx: vec2<f64>, qy: vec2<f64>) -> f64 {
-    let lead = px.x * qy.x - py.x * qx.x;
-    return lead + ((px.x * qy.y + px.y * qy.x) - (py.x * qx.y + py.y * qx.x));
+    let lead = xmul(px.x, qy.x) - xmul(py.x, qx.x);
+    return lead + ((xmul(px.x, qy.y) + xmul(px.y, qy.x)) - (xmul(py.x, qx.y) + xmul(py.y, qx.x)));
 }
 
 // A vertex relative to the origin, in ray axis order, each coordinate split.
@@ -108,8 +123,8 @@ fn shear64(p: Rel64) -> array<vec2<f64>, 2> {
     let dx = f64(TR.d.x);
     let dy = f64(TR.d.y);
     let dz = f64(TR.d.z);
-    let x = ((dz * p.x.x - dx * p.z.x) + dz * p.x.y) - dx * p.z.y;
-    let y = ((dz * p.y.x - dy * p.z.x) + dz * p.y.y) - dy * p.z.y;
+    let x = ((xmul(dz, p.x.x) - xmul(dx, p.z.x)) + xmul(dz, p.x.y)) - xmul(dx, p.z.y);
+    let y = ((xmul(dz, p.y.x) - xmul(dy, p.z.x)) + xmul(dz, p.y.y)) - xmul(dy, p.z.y);
     return array<vec2<f64>, 2>(split64(x), split64(y));
 }
 
@@ -133,7 +148,7 @@ fn tri_refine(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>) -> TriHit {
     let num = (mul2_64(split64(u), ra.z) + mul2_64(split64(v), rb.z)) + mul2_64(split64(w), rc.z);
     let d = split64(det);
     let dz = f64(TR.d.z);
-    let den = d.x * dz + d.y * dz;
+    let den = xmul(d.x, dz) + xmul(d.y, dz);
     let num32 = f32(num);
     let den32 = f32(den);
     let det32 = f32(det);
