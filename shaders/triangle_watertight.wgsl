@@ -118,11 +118,27 @@ fn rel64(p: vec3<f32>) -> Rel64 {
     );
 }
 
-// The sheared coordinates times dz, split: `((dz x - dx z) + dz x_lo) - dx z_lo`.
-fn shear64(p: Rel64) -> array<vec2<f64>, 2> {
-    let dx = f64(TR.d.x);
-    let dy = f64(TR.d.y);
-    let dz = f64(TR.d.z);
+// `intersect::refine::inverse_scale`: 2^-e for a normal x with 2^e <= |x| < 2^(e+1), else 1, as
+// the exact product of two f32 powers of two.
+fn inverse_scale64(x: f32) -> f64 {
+    let e = i32((bitcast<u32>(x) >> 23u) & 0xffu);
+    if e == 0 || e == 255 {
+        return 1.0;
+    }
+    let k = 127 - e;
+    // Floor division by 2 (k may be negative).
+    let half = (k - select(0, 1, k < 0 && (k & 1) != 0)) / 2;
+    let p0 = f64(bitcast<f32>(u32(half + 127) << 23u));
+    let p1 = f64(bitcast<f32>(u32(k - half + 127) << 23u));
+    return xmul(p0, p1);
+}
+
+// The sheared coordinates times dz, split: `((dz x - dx z) + dz x_lo) - dx z_lo`, the direction
+// scaled by `scale` (so that 1 <= |dz| < 2).
+fn shear64(p: Rel64, scale: f64) -> array<vec2<f64>, 2> {
+    let dx = xmul(f64(TR.d.x), scale);
+    let dy = xmul(f64(TR.d.y), scale);
+    let dz = xmul(f64(TR.d.z), scale);
     let x = ((xmul(dz, p.x.x) - xmul(dx, p.z.x)) + xmul(dz, p.x.y)) - xmul(dx, p.z.y);
     let y = ((xmul(dz, p.y.x) - xmul(dy, p.z.x)) + xmul(dz, p.y.y)) - xmul(dy, p.z.y);
     return array<vec2<f64>, 2>(split64(x), split64(y));
@@ -134,9 +150,12 @@ fn tri_refine(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>) -> TriHit {
     let ra = rel64(a0);
     let rb = rel64(b0);
     let rc = rel64(c0);
-    let a = shear64(ra);
-    let b = shear64(rb);
-    let c = shear64(rc);
+    // The direction scaled to 1 <= |dz| < 2, as on the CPU (a dz far from 1 would leave the
+    // denominator subnormal in f32).
+    let scale = inverse_scale64(TR.d.z);
+    let a = shear64(ra, scale);
+    let b = shear64(rb, scale);
+    let c = shear64(rc, scale);
     let u = edge64(c[0], c[1], b[0], b[1]);
     let w = edge64(b[0], b[1], a[0], a[1]);
     let v = edge64(a[0], a[1], c[0], c[1]);
@@ -147,7 +166,7 @@ fn tri_refine(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>) -> TriHit {
     let det = (u + v) + w;
     let num = (mul2_64(split64(u), ra.z) + mul2_64(split64(v), rb.z)) + mul2_64(split64(w), rc.z);
     let d = split64(det);
-    let dz = f64(TR.d.z);
+    let dz = xmul(f64(TR.d.z), scale);
     let den = xmul(d.x, dz) + xmul(d.y, dz);
     let num32 = f32(num);
     let den32 = f32(den);
@@ -158,7 +177,8 @@ fn tri_refine(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>) -> TriHit {
         || den32 == 0.0 || det32 == 0.0 {
         return TriHit(false, 0.0, 0.0, 0.0);
     }
-    return TriHit(true, div_rn(num32, den32), div_rn(v32, det32), div_rn(w32, det32));
+    let t = f32(xmul(f64(div_rn(num32, den32)), scale));
+    return TriHit(true, t, div_rn(v32, det32), div_rn(w32, det32));
 }
 
 fn tri_intersect(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>, tmin: f32, tmax: f32) -> TriHit {

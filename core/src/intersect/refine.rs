@@ -77,15 +77,38 @@ fn edge(p: [(f64, f64); 2], q: [(f64, f64); 2]) -> f64 {
     lead + ((p[0].0 * q[1].1 + p[0].1 * q[1].0) - (p[1].0 * q[0].1 + p[1].1 * q[0].0))
 }
 
+/// `2^-e` for a normal `x` with `2^e <= |x| < 2^(e+1)`, else 1: the product of two `f32` powers
+/// of two (each within the normal range), exact in `f64`, so the WGSL kernel can form the same
+/// value without building an `f64` from bits.
+#[inline(always)]
+fn inverse_scale(x: f32) -> f64 {
+    let e = ((x.to_bits() >> 23) & 0xff) as i32;
+    if e == 0 || e == 255 {
+        return 1.0;
+    }
+    let k = 127 - e;
+    let half = k.div_euclid(2);
+    let pow2 = |k: i32| f32::from_bits(((k + 127) as u32) << 23) as f64;
+    pow2(half) * pow2(k - half)
+}
+
 /// The hit recomputed in `f64` from the `f32` inputs: `origin` and `dir` in ray axis order
 /// (`kx, ky, kz`, the same permutation as the test's), the vertices `v` as stored. `None` where a
 /// value leaves the `f32` range (the caller keeps its `f32` hit).
 ///
 /// The ray is sheared without dividing: `X = dz·x − dx·z` is `dz` times the sheared coordinate,
 /// so the edge functions come out `dz²` times the test's and `t = Σ U_i z_i / (dz Σ U_i)`.
+///
+/// The direction is first scaled by a power of two so that `1 <= |dz| < 2` (exact, and the
+/// distance is scaled back at the end, exactly where it stays normal): with `dz` far from 1 (the
+/// backends scale scenes to unit size and the directions with them, `2^-39` for a scene of
+/// size 1e12) the denominator `dz³` times the test's would otherwise come out subnormal in `f32`
+/// and lose most of its bits.
 #[inline(never)]
 pub(crate) fn refine(origin: [f32; 3], dir: [f32; 3], k: [usize; 3], v: [&[f32; 3]; 3]) -> Option<Refined> {
-    let [dx, dy, dz] = dir.map(f64::from);
+    let scale = inverse_scale(dir[2]);
+    // Each still an f32 significand, so the products below stay exact.
+    let [dx, dy, dz] = dir.map(|x| f64::from(x) * scale);
     // The relative position, exact in f64 but for exponents far apart, as two f32 parts.
     let rel = v.map(|p| core::array::from_fn::<_, 3, _>(|i| split(p[k[i]] as f64 - origin[i] as f64)));
     let shear = |p: &[(f64, f64); 3]| {
@@ -111,5 +134,7 @@ pub(crate) fn refine(origin: [f32; 3], dir: [f32; 3], k: [usize; 3], v: [&[f32; 
     if ![num, den, det, v_, w_].iter().all(|x| x.is_finite()) || den == 0.0 || det == 0.0 {
         return None;
     }
-    Some((num / den, v_ / det, w_ / det))
+    // `t` along the scaled direction, times the scale: `t` along the ray.
+    let t = (f64::from(num / den) * scale) as f32;
+    Some((t, v_ / det, w_ / det))
 }
