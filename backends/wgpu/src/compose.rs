@@ -7,7 +7,7 @@
 //!   disjoint-interval mask.
 
 use crate::config::Dispatch;
-use raytrail_core::intersect::{FAR_PAD, RELIABLE_LIMIT, SLACK_SCALE};
+use raytrail_core::intersect::{FAR_PAD, REFINE_SCALE, RELIABLE_LIMIT, SLACK_SCALE};
 use raytrail_core::kd::traverse::{PACKET_WIDTH, SHORT_STACK_MAX};
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query};
@@ -213,6 +213,7 @@ pub(crate) fn constants_header(method: Method) -> String {
          const FAR_PAD_BITS: u32 = {:#010x}u;\n\
          const SLACK_SCALE_BITS: u32 = {:#010x}u;\n\
          const RELIABLE_LIMIT_BITS: u32 = {:#010x}u;\n\
+         const REFINE_SCALE_BITS: u32 = {:#010x}u;\n\
          // kd restart family: 0 restart, 1 push-down, 2 short stack.\n\
          const KD_MODE: u32 = {kd_mode}u;\n\
          const SHORT_STACK_MAX: u32 = {SHORT_STACK_MAX}u;\n\
@@ -222,6 +223,7 @@ pub(crate) fn constants_header(method: Method) -> String {
         FAR_PAD.to_bits(),
         SLACK_SCALE.to_bits(),
         RELIABLE_LIMIT.to_bits(),
+        REFINE_SCALE.to_bits(),
     )
 }
 
@@ -296,6 +298,7 @@ mod tests {
         let h = constants_header(Method::Bvh2(Bvh2Method::Stack));
         assert!(h.contains(&format!("{:#010x}", FAR_PAD.to_bits())));
         assert!(h.contains(&format!("{:#010x}", SLACK_SCALE.to_bits())));
+        assert!(h.contains(&format!("{:#010x}", REFINE_SCALE.to_bits())));
         assert_eq!(SLACK_SCALE.to_bits(), (1.0f32 / 524288.0).to_bits());
     }
 }

@@ -6,6 +6,7 @@
 mod block;
 mod context;
 mod moller_trumbore;
+mod refine;
 mod slab;
 mod slab_pair;
 #[cfg(test)]
@@ -15,6 +16,7 @@ mod watertight;
 pub use block::{BlockHits, TriangleBlock, BLOCK};
 pub use context::{BoxConstants, KdRayContext, NoPair, RayContext, RELIABLE_LIMIT, SLACK_SCALE, SLACK_ULPS};
 pub use moller_trumbore::MollerTrumbore;
+pub use refine::{REFINE_SCALE, REFINE_ULPS};
 pub use slab::{BoxHit, SlabRay, FAR_PAD};
 pub use slab_pair::{hit_pair_scalar, SlabPair};
 pub use watertight::Watertight;

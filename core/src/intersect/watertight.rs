@@ -1,3 +1,4 @@
+use super::refine::{needs_refine, refine};
 use super::{BlockHits, TriangleBlock, TriangleHit, TriangleTest};
 use crate::Ray;
 use glam::{Vec3, Vec3A};
@@ -6,7 +7,10 @@ use glam::{Vec3, Vec3A};
 ///
 /// The ray is sheared so it runs along +z; edge functions are evaluated in 2D and recomputed in
 /// `f64` when one is exactly zero, so that a ray through a shared edge or vertex hits exactly one
-/// of the triangles sharing it (no cracks, no double hits). Backfaces are not culled.
+/// of the triangles sharing it (no cracks, no double hits). Backfaces are not culled. Where a
+/// first-order bound says the `f32` distance may be more than
+/// [`REFINE_ULPS`](super::REFINE_ULPS) ulps off (slanted slivers), `t` and the barycentrics are
+/// recomputed in `f64`.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Watertight;
 
@@ -19,6 +23,8 @@ pub struct ShearedRay {
     k: [usize; 3],
     /// Shear constants `dx/dz`, `dy/dz`, `1/dz`.
     s: [f32; 3],
+    /// The direction in the permuted order, for the `f64` recomputation.
+    d: [f32; 3],
 }
 
 impl TriangleTest for Watertight {
@@ -47,7 +53,7 @@ impl TriangleTest for Watertight {
         let o = ray.origin;
         // `dx/dz, dy/dz, 1/dz` as one 4-wide division where SIMD is available (IEEE per lane).
         let s = Vec3A::new(d[kx], d[ky], 1.0) / Vec3A::splat(dz);
-        ShearedRay { origin: [o[kx], o[ky], o[kz]], k: [kx, ky, kz], s: s.to_array() }
+        ShearedRay { origin: [o[kx], o[ky], o[kz]], k: [kx, ky, kz], s: s.to_array(), d: [d[kx], d[ky], dz] }
     }
 
     #[inline(always)]
@@ -60,6 +66,7 @@ impl TriangleTest for Watertight {
     /// trip through memory per coordinate.
     #[inline(always)]
     fn intersect_in_place(r: &ShearedRay, v: [&[f32; 3]; 3], tmin: f32, tmax: f32) -> Option<TriangleHit> {
+        let vertices = v;
         let [kx, ky, kz] = r.k;
         let [ox, oy, oz] = r.origin;
         let [sx, sy, sz] = r.s;
@@ -93,15 +100,30 @@ impl TriangleTest for Watertight {
         let cz = sz * c[2];
         let t = (u * az + v * bz + w * cz) / det;
         // A `t` that overflowed (directions near the float limits) is no hit.
-        if !t.is_finite() || t < tmin || t > tmax {
+        if !t.is_finite() || t < tmin {
             return None;
         }
-        Some(TriangleHit { t, u: v / det, v: w / det })
+        let mut hit = TriangleHit { t, u: v / det, v: w / det };
+        // Decided before `tmax` is looked at: `tmax` is the closest hit so far, which depends on
+        // the traversal order, and a refined `t` may cross it either way.
+        if needs_refine([a, b, c], [[ax, ay], [bx, by], [cx, cy]], [az, bz, cz], t, det) {
+            if let Some((t, u, v)) = refine(r.origin, r.d, r.k, vertices) {
+                hit = TriangleHit { t, u, v };
+            }
+            if !hit.t.is_finite() || hit.t < tmin {
+                return None;
+            }
+        }
+        if hit.t > tmax {
+            return None;
+        }
+        Some(hit)
     }
 
     /// Four triangles at once (SSE on x86_64), each lane the scalar test's operations in its
     /// order, so every answer is [`Watertight::intersect_in_place`]'s bit for bit; a lane with a
-    /// zero edge function takes the scalar test and its `f64` fallback.
+    /// zero edge function, or one the error bound flags for the `f64` recomputation, takes the
+    /// scalar test.
     #[inline(always)]
     fn intersect_block(r: &ShearedRay, block: &TriangleBlock, tmin: f32, tmax: f32) -> BlockHits {
         #[cfg(target_arch = "x86_64")]
@@ -121,6 +143,7 @@ impl TriangleTest for Watertight {
 /// The SSE path of [`Watertight::intersect_block`] (SSE2 is part of the x86_64 baseline).
 #[cfg(target_arch = "x86_64")]
 mod sse {
+    use super::super::REFINE_SCALE;
     use super::{BlockHits, ShearedRay, TriangleBlock, TriangleTest, Watertight};
     use core::arch::x86_64::{
         __m128, _mm_add_ps, _mm_and_ps, _mm_andnot_ps, _mm_cmpeq_ps, _mm_cmpgt_ps, _mm_cmplt_ps, _mm_cmpngt_ps,
@@ -135,7 +158,7 @@ mod sse {
         let [ox, oy, oz] = r.origin;
         let [sx, sy, sz] = r.s;
         // SAFETY: SSE2 is part of the x86_64 baseline; loads and stores are of four-float arrays.
-        let (ok, t, u, v, zero) = unsafe {
+        let (ok, t, u, v, slow) = unsafe {
             let splat = _mm_set1_ps;
             let load = |a: &[f32; 4]| _mm_loadu_ps(a.as_ptr());
             let rel = |vertex: usize| {
@@ -169,26 +192,48 @@ mod sse {
             // `!t.is_finite() || t < tmin || t > tmax` rejects: NaN fails `|t| < inf`.
             let abs_t = _mm_andnot_ps(splat(-0.0), t);
             let finite = _mm_cmplt_ps(abs_t, splat(f32::INFINITY));
-            let in_range = _mm_and_ps(_mm_cmpnlt_ps(t, splat(tmin)), _mm_cmpngt_ps(t, splat(tmax)));
             let det_ok = _mm_andnot_ps(_mm_cmpeq_ps(det, z), _mm_cmpeq_ps(z, z));
-            let ok = _mm_and_ps(_mm_andnot_ps(_mm_and_ps(neg, pos), det_ok), _mm_and_ps(finite, in_range));
+            // Hit at a `t` past `tmin`: what the error bound screens, whatever `tmax` is.
+            let ahead = _mm_and_ps(
+                _mm_andnot_ps(_mm_and_ps(neg, pos), det_ok),
+                _mm_and_ps(finite, _mm_cmpnlt_ps(t, splat(tmin))),
+            );
+            let ok = _mm_and_ps(ahead, _mm_cmpngt_ps(t, splat(tmax)));
+            let zero = _mm_movemask_ps(zero) as u32;
+            // The bound only where a lane hits (rare among blocks), so a block of misses pays
+            // one branch for it.
+            let mut slow = zero;
+            let screened = _mm_movemask_ps(ahead) as u32 & !zero;
+            if screened != 0 {
+                let abs = |x: __m128| _mm_andnot_ps(splat(-0.0), x);
+                let m = |p0: __m128, p1: __m128, p2: __m128| {
+                    _mm_add_ps(_mm_add_ps(abs(p0), abs(p1)), _mm_add_ps(abs(p2), abs(p2)))
+                };
+                let (ma, mb, mc) = (m(a0, a1, a2), m(b0, b1, b2), m(c0, c1, c2));
+                let (sa, sb, sc) =
+                    (_mm_add_ps(abs(ax), abs(ay)), _mm_add_ps(abs(bx), abs(by)), _mm_add_ps(abs(cx), abs(cy)));
+                let e = |mp: __m128, sq: __m128, mq: __m128, sp: __m128| {
+                    _mm_add_ps(_mm_add_ps(_mm_mul_ps(mp, sq), _mm_mul_ps(mq, sp)), _mm_mul_ps(sp, sq))
+                };
+                let (eu, ev, ew) = (e(mb, sc, mc, sb), e(mc, sa, ma, sc), e(ma, sb, mb, sa));
+                let dz = |zz: __m128| abs(_mm_sub_ps(zz, t));
+                let lhs =
+                    _mm_add_ps(_mm_add_ps(_mm_mul_ps(eu, dz(az)), _mm_mul_ps(ev, dz(bz))), _mm_mul_ps(ew, dz(cz)));
+                let rhs = _mm_mul_ps(splat(REFINE_SCALE), abs(_mm_mul_ps(t, det)));
+                slow |= _mm_movemask_ps(_mm_cmpgt_ps(lhs, rhs)) as u32 & screened;
+            }
             let store = |x: __m128| {
                 let mut out = [0.0f32; 4];
                 _mm_storeu_ps(out.as_mut_ptr(), x);
                 out
             };
-            (
-                _mm_movemask_ps(ok) as u32,
-                store(t),
-                store(_mm_div_ps(v, det)),
-                store(_mm_div_ps(w, det)),
-                _mm_movemask_ps(zero) as u32,
-            )
+            (_mm_movemask_ps(ok) as u32, store(t), store(_mm_div_ps(v, det)), store(_mm_div_ps(w, det)), slow)
         };
-        let mut out = BlockHits { mask: ok & !zero, t, u, v };
-        // A zero edge function (rare): the scalar test, with its f64 recomputation. The hit lanes
-        // are left as a mask, so the caller branches on hits rather than on each lane.
-        let mut z = zero;
+        let mut out = BlockHits { mask: ok & !slow, t, u, v };
+        // A zero edge function or a flagged hit (rare): the scalar test, with its f64
+        // recomputations. The hit lanes are left as a mask, so the caller branches on hits rather
+        // than on each lane.
+        let mut z = slow;
         while z != 0 {
             let lane = z.trailing_zeros() as usize;
             let [a, b, c] = block.lane(lane);
@@ -260,6 +305,7 @@ mod tests {
             core::mem::swap(&mut kx, &mut ky);
         }
         let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+        let vertices = [a.to_array(), b.to_array(), c.to_array()];
         let (a, b, c) = (a - ray.origin(), b - ray.origin(), c - ray.origin());
         let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
         let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
@@ -277,10 +323,24 @@ mod tests {
             return None;
         }
         let t = (u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz])) / det;
-        if !t.is_finite() || t < ray.tmin || t > ray.tmax {
+        if !t.is_finite() || t < ray.tmin {
             return None;
         }
-        Some(TriangleHit { t, u: v / det, v: w / det })
+        let mut hit = TriangleHit { t, u: v / det, v: w / det };
+        let k = [kx, ky, kz];
+        let rel = [a, b, c].map(|p| k.map(|i| p[i]));
+        let xy = [[ax, ay], [bx, by], [cx, cy]];
+        if needs_refine(rel, xy, [sz * a[kz], sz * b[kz], sz * c[kz]], t, det) {
+            let o = ray.origin();
+            let [p, q, r] = &vertices;
+            if let Some((t, u, v)) = refine(k.map(|i| o[i]), k.map(|i| d[i]), k, [p, q, r]) {
+                hit = TriangleHit { t, u, v };
+            }
+            if !hit.t.is_finite() || hit.t < ray.tmin {
+                return None;
+            }
+        }
+        (hit.t <= ray.tmax).then_some(hit)
     }
 
     #[test]
