@@ -29,9 +29,15 @@ fn inside_camera(b: rc::Aabb) -> conf::rays::Camera {
     conf::rays::Camera { eye, target, up: u, tan_half_vfov: 1.0 }
 }
 
+/// Ends the run with `msg` (the inputs are the script's arguments: a bad one is a usage error).
+fn die(msg: String) -> ! {
+    eprintln!("ab-cpu: {msg}");
+    std::process::exit(2)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let path = &args[1];
+    let Some(path) = args.get(1) else { die("usage: SCENE [VIEW] [METHOD] [ROUNDS] [SETS]".into()) };
     let view = args.get(2).map(String::as_str).unwrap_or("inside");
     let method = args.get(3).map(String::as_str).unwrap_or("bvh8").to_string();
     let rounds: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(15);
@@ -50,8 +56,8 @@ fn main() {
         .unwrap_or((384, 288));
 
     // New side.
-    let mesh = rc::mesh::load(Path::new(path)).unwrap();
-    let scene = mesh.to_scene().unwrap();
+    let mesh = rc::mesh::load(Path::new(path)).unwrap_or_else(|e| die(e.to_string()));
+    let scene = mesh.to_scene().unwrap_or_else(|e| die(format!("{path}: {e}")));
     let mut cfg = rc::bvh2::SahConfig::default();
     let envf = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f32>().ok());
     if let Some(t) = envf("AB_TRAV") {
@@ -68,7 +74,7 @@ fn main() {
     }
     let bvh = rc::bvh2::SahBuilder { config: cfg }.build(scene.triangles()).unwrap();
     eprintln!("new tree: {:?}", bvh.stats());
-    let m = rc::method::Method::from_name(&method).unwrap();
+    let m = rc::method::Method::from_name(&method).unwrap_or_else(|| die(format!("unknown method {method}")));
     let prepared = Arc::new(rc::prepared::PreparedScene::new(&scene, bvh, &[m]).unwrap());
     let newb = rcpu::CpuBackend::with_threads(1).unwrap();
     use rc::trace::Trace;
@@ -77,7 +83,8 @@ fn main() {
     let omesh = oc::mesh::load(Path::new(path)).unwrap();
     let oscene = omesh.to_scene().unwrap();
     let obvh = oc::bvh2::SahBuilder::default().build(oscene.triangles()).unwrap();
-    let om = oc::method::Method::from_name(&method).unwrap();
+    let om = oc::method::Method::from_name(&method)
+        .unwrap_or_else(|| die(format!("{method}: not a method of the old commit")));
     let oprepared = Arc::new(oc::prepared::PreparedScene::new(&oscene, obvh, &[om]).unwrap());
     let oldb = ocpu::CpuBackend::with_threads(1).unwrap();
     use oc::trace::Trace as OTrace;
