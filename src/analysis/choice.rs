@@ -39,9 +39,11 @@ pub const ROUND_PRUNE_FACTOR: f64 = 1.5;
 /// A later candidate must be faster than an earlier one by more than this fraction of its time to
 /// be chosen over it. A sample is a small working set, which flatters the methods with larger
 /// structures: on camera rays into the kitchen, samples had kd-stack (8 references per triangle)
-/// within 1-7% of bvh8, and the whole batch 12-16% behind it. The candidates come in the order
-/// that is cheapest to get wrong, bvh8 first.
-pub const EARLIER_MARGIN: f64 = 0.05;
+/// up to 7% ahead of bvh8, and the whole batch 12-16% behind it (it was 5% until that sample
+/// chose kd-stack in two of three runs). A margin of 10% keeps an earlier candidate unless the
+/// sample says it loses by more than the tolerance `auto` is held to. The candidates come in the
+/// order that is cheapest to get wrong, bvh8 first.
+pub const EARLIER_MARGIN: f64 = 0.10;
 
 /// How much of the sample a trace covers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -242,7 +244,7 @@ mod tests {
     #[test]
     fn slow_candidates_are_looked_at_once_on_part_of_the_sample() {
         let mut clock =
-            Replay::new(&[(BVH8, 1.0, &[1.0, 1.0, 1.0]), (KD, 0.9, &[0.9, 0.9, 0.9]), (STREAM, 2.3, &[0.1, 0.1, 0.1])]);
+            Replay::new(&[(BVH8, 1.0, &[1.0, 1.0, 1.0]), (KD, 0.9, &[0.8, 0.8, 0.8]), (STREAM, 2.3, &[0.1, 0.1, 0.1])]);
         let c = choose(&[BVH8, KD, STREAM], 3, &mut clock).unwrap();
         assert_eq!(c.method, KD);
         // The first look covers part of the sample; then the survivors alternate over the
@@ -303,9 +305,9 @@ mod tests {
         let mut clock = Replay::new(&[(STACK, 1.0, &[1.0, 1.0, 1.0]), (BVH8, 1.0, &[1.0, 1.0, 1.0])]);
         assert_eq!(choose(&[STACK, BVH8], 3, &mut clock).unwrap().method, STACK);
         // Within the margin is a tie too; beyond it the later one wins.
-        let mut clock = Replay::new(&[(BVH8, 1.0, &[1.0, 1.0, 1.0]), (KD, 1.0, &[0.96, 0.96, 0.96])]);
+        let mut clock = Replay::new(&[(BVH8, 1.0, &[1.0, 1.0, 1.0]), (KD, 1.0, &[0.91, 0.91, 0.91])]);
         assert_eq!(choose(&[BVH8, KD], 3, &mut clock).unwrap().method, BVH8);
-        let mut clock = Replay::new(&[(BVH8, 1.0, &[1.0, 1.0, 1.0]), (KD, 1.0, &[0.94, 0.94, 0.94])]);
+        let mut clock = Replay::new(&[(BVH8, 1.0, &[1.0, 1.0, 1.0]), (KD, 1.0, &[0.89, 0.89, 0.89])]);
         assert_eq!(choose(&[BVH8, KD], 3, &mut clock).unwrap().method, KD);
     }
 
