@@ -1,33 +1,12 @@
 //! The harness of `scripts/ab-cpu.sh` (see there): the same rays through an old commit's CPU
 //! backend (`oc`, `ocpu`) and the working tree's (`rc`, `rcpu`), one thread, interleaved rounds.
 //!
-//! Rays: primary rays of the bench's outside or inside view (the inside camera below is the
-//! bench's, `cli/src/bench/view.rs`), their diffuse bounces, shadow rays to the default light,
+//! Rays: primary rays of the bench's outside or inside view (the conformance suite's
+//! `Camera::inside`, as the bench's), their diffuse bounces, shadow rays to the default light,
 //! and ambient-occlusion rays (the bounces cut to 5% of the scene's diagonal).
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
-
-/// The bench's inside camera: low in the box, looking along its longer horizontal side.
-fn inside_camera(b: rc::Aabb) -> conf::rays::Camera {
-    let (min, e) = (b.min, b.extent());
-    let ea = e.to_array();
-    let shortest = if ea[0] < ea[2] { 0 } else { 2 };
-    let up = if ea[shortest] < 0.5 * ea[1] { shortest } else { 1 };
-    let (a, bb) = match up {
-        0 => (1, 2),
-        1 => (0, 2),
-        _ => (0, 1),
-    };
-    let fwd = if e[bb] > e[a] { bb } else { a };
-    let mut eye = b.center();
-    eye[up] = min[up] + 0.25 * e[up];
-    let mut target = eye;
-    target[fwd] += e[fwd].max(1.0);
-    let mut u = glam::Vec3::ZERO;
-    u[up] = 1.0;
-    conf::rays::Camera { eye, target, up: u, tan_half_vfov: 1.0 }
-}
 
 /// Ends the run with `msg` (the inputs are the script's arguments: a bad one is a usage error).
 fn die(msg: String) -> ! {
@@ -91,7 +70,7 @@ fn main() {
     let os = oldb.prepare(oprepared).unwrap();
 
     let bounds = scene.bounds();
-    let cam = if view == "inside" { inside_camera(bounds) } else { conf::rays::Camera::framing(bounds) };
+    let cam = if view == "inside" { conf::rays::Camera::inside(bounds) } else { conf::rays::Camera::framing(bounds) };
     let prim = conf::rays::primary_from(&cam, w, h);
     let mut hits = vec![rc::Hit::MISS; prim.len()];
     newb.trace(&ns, &prim, &rc::trace::TraceOptions::new(m), &mut hits).unwrap();

@@ -12,12 +12,14 @@
 
 mod adversarial;
 mod diffuse;
+mod inside;
 mod primary;
 mod shadow;
 mod uniform;
 
 pub use adversarial::adversarial;
 pub use diffuse::diffuse;
+pub use inside::up_axis;
 pub use primary::{morton_encode, morton_order, primary, primary_from, Camera};
 pub use shadow::shadow;
 pub use uniform::uniform_random;
