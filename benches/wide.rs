@@ -36,6 +36,7 @@ const METHODS: &[Method] = &[
     Method::Wide(WideMethod::Bvh4),
     Method::Wide(WideMethod::Bvh8),
     Method::Wide(WideMethod::Bvh4Naive),
+    Method::Wide(WideMethod::Bvh8Sah),
 ];
 /// Length of an ambient-occlusion ray as a fraction of the scene's diagonal (the CLI bench's).
 const AO_RADIUS: f32 = 0.05;
@@ -92,12 +93,13 @@ impl Variant {
 
 /// The variants traced for `query`: sorted any-hit only where it differs from the default.
 fn variants(query: Query) -> Vec<Variant> {
-    use WideMethod::{Bvh4, Bvh4Naive, Bvh8};
+    use WideMethod::{Bvh4, Bvh4Naive, Bvh8, Bvh8Sah};
     let mut v = vec![
         Variant::Binary,
         Variant::Wide(Bvh4, Kernel::Fast),
         Variant::Wide(Bvh8, Kernel::Fast),
         Variant::Wide(Bvh4Naive, Kernel::Fast),
+        Variant::Wide(Bvh8Sah, Kernel::Fast),
         Variant::Wide(Bvh4, Kernel::OneTri),
         Variant::Wide(Bvh8, Kernel::OneTri),
     ];

@@ -8,11 +8,14 @@
 #   scripts/ab-cpu.sh OLD_REV SCENE [VIEW=inside] [METHOD=bvh8] [ROUNDS=15] [SETS=primary,shadow,diffuse,ao]
 #
 # Environment: AB_SIZE=WxH (primary rays, default 384x288); AB_TRAV, AB_MAXLEAF, AB_BLOCK, AB_BINS
-# change the new side's SAH settings (to try a builder change without editing it). The old commit is
-# checked out in a temporary worktree with its two crates renamed, so both link into one binary.
+# change the new side's SAH settings (to try a builder change without editing it); AB_FRESH=0 keeps
+# one copy of each tree for all rounds (by default each round traces fresh copies, so that where
+# the trees land in physical memory, which moved a set by up to 25% between runs, averages out).
+# The old commit is checked out in a temporary worktree with its two crates renamed, so both link
+# into one binary.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 2 ] || { sed -n 2,11p "$0"; exit 2; }
+[ $# -ge 2 ] || { sed -n 2,13p "$0"; exit 2; }
 rev=$1; shift
 old=$(mktemp -d /tmp/raytrail-ab-old.XXXXXX)
 trap 'git -C "$root" worktree remove --force "$old" >/dev/null 2>&1 || true' EXIT

@@ -1,7 +1,7 @@
-// Methods bvh4, bvh8, bvh4-naive: a wide BVH collapsed from the binary one (Guthe 2014), one state
-// machine for every width (`wide::traverse::WideState`): all children of a node tested, the hit
-// ones nearest first by a bitonic sorting network for closest-hit queries and in slot order for
-// any-hit queries, all but the first pushed with their entry distances, and a popped child
+// Methods bvh4, bvh8, bvh4-naive, bvh8-sah: a wide BVH collapsed from the binary one (Guthe 2014),
+// one state machine for every width (`wide::traverse::WideState`): all children of a node tested,
+// the hit ones nearest first by a bitonic sorting network for closest-hit queries and in slot order
+// for any-hit queries, all but the first pushed with their entry distances, and a popped child
 // dropped when it is entered beyond the closest hit by more than the slack.
 //
 // Memory (the `kd` binding, words): nodes of 8 * WIDE_W words each (`wide::WideNode`: lo x, y, z,

@@ -67,7 +67,7 @@ pub fn usage<T>(m: impl Into<String>) -> Result<T, Failure> {
 const AFTER_HELP: &str = "\
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
          kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree);
-         bvh4, bvh8, bvh4-naive (wide BVH); stream (ray stream);
+         bvh4, bvh8, bvh4-naive, bvh8-sah (wide BVH); stream (ray stream);
          auto (trace's default; bench --methods): the fastest of bvh8, kd-stack, stack and stream
          timed on a sample of the rays (`raytrail explain SCENE` shows the choice per ray type)
 SCENES:  OBJ, PLY (ASCII or binary), OFF, STL (ASCII or binary), glTF 2.0 (.gltf, .glb), any of them

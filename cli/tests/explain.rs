@@ -32,7 +32,7 @@ fn explain_analyses_the_builtin_scene() {
     }
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["scene"], "sphereflake");
-    assert_eq!(v["parts"].as_array().unwrap().len(), 9);
+    assert_eq!(v["parts"].as_array().unwrap().len(), raytrail::core::prepared::Part::ALL.len());
     assert_eq!(v["methods"].as_array().unwrap().len(), raytrail::core::method::Method::ALL.len());
     let choices = v["choices"].as_array().unwrap();
     let kinds: Vec<&str> = choices.iter().map(|c| c["rays"].as_str().unwrap()).collect();

@@ -1,6 +1,6 @@
 //! The wide trees collapsed from the binary one: every binary leaf kept whole and reached once,
 //! child boxes the binary nodes' own, the width respected, and the pull-up's shape against the
-//! naive collapse (Guthe 2014, Sec. 4.1).
+//! naive collapse (Guthe 2014, Sec. 4.1), and the SAH-optimal cut's total node area against both.
 
 use raytrail_core::bvh2::{Bvh2, NodeKind, SahBuilder, SahConfig};
 use raytrail_core::method::Collapse;
@@ -72,7 +72,7 @@ fn every_binary_leaf_is_reached_once_with_its_box_and_triangles() {
         let tris = soup(3000, seed, 2.0);
         let bvh = SahBuilder::new(SahConfig { max_leaf_size: leaf, ..SahConfig::default() }).build(&tris).unwrap();
         let expected = binary_leaves(&bvh);
-        for collapse in [Collapse::PullUp, Collapse::EverySecondLevel] {
+        for collapse in [Collapse::PullUp, Collapse::EverySecondLevel, Collapse::Optimal] {
             let w4 = WideBvh::<4>::build(&bvh, &tris, collapse).unwrap();
             assert_eq!(check(&bvh, &w4), expected, "4-wide {collapse:?}");
             let w8 = WideBvh::<8>::build(&bvh, &tris, collapse).unwrap();
@@ -104,4 +104,40 @@ fn a_single_leaf_tree_is_a_leaf_root() {
     let w = WideBvh::<4>::build(&bvh, &tris, Collapse::PullUp).unwrap();
     assert_eq!(w.root(), WideChild::Leaf { first: 0, count: 1 });
     assert!(w.nodes().is_empty());
+}
+
+/// The total half area of the binary nodes a wide tree's nodes stand for: the part of the
+/// surface-area cost that depends on the cut.
+fn node_area<const W: usize>(bvh: &Bvh2, wide: &WideBvh<W>) -> f64 {
+    (0..wide.nodes().len() as u32)
+        .map(|n| {
+            let id = wide.canonical_id(WideChild::Node(n).node_ref()).expect("a node names a binary node");
+            f64::from(bvh.nodes()[id as usize].bounds.half_area())
+        })
+        .sum()
+}
+
+#[test]
+fn the_optimal_cut_has_no_more_node_area_than_either_greedy_collapse() {
+    let mut strictly_less = 0;
+    for (seed, leaf) in [(11, 1), (12, 4), (13, 8)] {
+        let tris = soup(5000, seed, 2.0);
+        let bvh = SahBuilder::new(SahConfig { max_leaf_size: leaf, ..SahConfig::default() }).build(&tris).unwrap();
+        let areas = |collapse| {
+            let a4 = node_area(&bvh, &WideBvh::<4>::build(&bvh, &tris, collapse).unwrap());
+            let a8 = node_area(&bvh, &WideBvh::<8>::build(&bvh, &tris, collapse).unwrap());
+            (a4, a8)
+        };
+        let (o4, o8) = areas(Collapse::Optimal);
+        for other in [Collapse::PullUp, Collapse::EverySecondLevel] {
+            let (g4, g8) = areas(other);
+            // Both greedy collapses are cuts the optimum chose among; allow the float sums'
+            // rounding.
+            assert!(o4 <= g4 * (1.0 + 1e-6), "4-wide: optimal {o4}, {other:?} {g4}");
+            assert!(o8 <= g8 * (1.0 + 1e-6), "8-wide: optimal {o8}, {other:?} {g8}");
+            strictly_less += usize::from(o4 < g4 * (1.0 - 1e-4)) + usize::from(o8 < g8 * (1.0 - 1e-4));
+        }
+    }
+    // A test that cannot tell the optimum from the pull-up would be no test.
+    assert!(strictly_less >= 6, "the optimal cut beat a greedy one only {strictly_less} times of 12");
 }

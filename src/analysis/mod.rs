@@ -134,6 +134,7 @@ pub fn maker(part: Part) -> Method {
         Part::Wide4 => Method::Wide(WideMethod::Bvh4),
         Part::Wide8 => Method::Wide(WideMethod::Bvh8),
         Part::Wide4Naive => Method::Wide(WideMethod::Bvh4Naive),
+        Part::Wide8Sah => Method::Wide(WideMethod::Bvh8Sah),
         Part::Levels => Method::Stream(StreamMethod::Frustum8),
     }
 }
@@ -157,7 +158,7 @@ pub fn prepare_every_part(
             Part::Hash => t.hash,
             Part::FullHash => t.full_hash,
             Part::Kd => t.kd,
-            Part::Wide4 | Part::Wide8 | Part::Wide4Naive => t.wide,
+            Part::Wide4 | Part::Wide8 | Part::Wide4Naive | Part::Wide8Sah => t.wide,
             Part::Levels => t.levels,
         };
         let bytes = p.part_bytes(part).ok_or(Error::NotPrepared { method: maker(part).name(), missing: "its part" })?;
@@ -175,6 +176,7 @@ pub fn prepare_every_part(
             Part::Wide4 => acc.wide4 = p.wide4.take(),
             Part::Wide8 => acc.wide8 = p.wide8.take(),
             Part::Wide4Naive => acc.wide4_naive = p.wide4_naive.take(),
+            Part::Wide8Sah => acc.wide8_sah = p.wide8_sah.take(),
             Part::Levels => acc.levels = p.levels.take(),
         }
     }

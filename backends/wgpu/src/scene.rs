@@ -45,6 +45,7 @@ pub struct WgpuScene {
     pub(crate) wide4: Option<KdBuffer>,
     pub(crate) wide8: Option<KdBuffer>,
     pub(crate) wide4_naive: Option<KdBuffer>,
+    pub(crate) wide8_sah: Option<KdBuffer>,
     /// The stream method's level-order tree, laid out as the wide trees are: nodes (eight words
     /// each, `LevelNode`), primitive ids, triangles.
     pub(crate) levels: Option<KdBuffer>,
@@ -145,6 +146,7 @@ impl WgpuScene {
         let wide4 = p.wide4.as_ref().map(|t| wide(gpu, "4-wide BVH", t)).transpose()?;
         let wide8 = p.wide8.as_ref().map(|t| wide(gpu, "8-wide BVH", t)).transpose()?;
         let wide4_naive = p.wide4_naive.as_ref().map(|t| wide(gpu, "naive 4-wide BVH", t)).transpose()?;
+        let wide8_sah = p.wide8_sah.as_ref().map(|t| wide(gpu, "SAH-optimal 8-wide BVH", t)).transpose()?;
         let levels = p
             .levels
             .as_ref()
@@ -169,6 +171,7 @@ impl WgpuScene {
             wide4,
             wide8,
             wide4_naive,
+            wide8_sah,
             levels,
             empty,
             workspace: Mutex::new(Workspace::default()),
@@ -214,6 +217,7 @@ impl WgpuScene {
             WideMethod::Bvh4 => self.wide4.as_ref(),
             WideMethod::Bvh8 => self.wide8.as_ref(),
             WideMethod::Bvh4Naive => self.wide4_naive.as_ref(),
+            WideMethod::Bvh8Sah => self.wide8_sah.as_ref(),
         }
     }
 
@@ -230,6 +234,7 @@ impl WgpuScene {
             + k(&self.wide4)
             + k(&self.wide8)
             + k(&self.wide4_naive)
+            + k(&self.wide8_sah)
             + k(&self.levels)
     }
 }

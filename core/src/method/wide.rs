@@ -14,6 +14,10 @@ pub enum WideMethod {
     /// Four children per node by removing every second level of the binary tree: the naive
     /// collapse the pull-up is measured against.
     Bvh4Naive,
+    /// Eight children per node, by the cut of least total node area ([`Collapse::Optimal`]):
+    /// fewer nodes per closest-hit ray than the pull-up, more per shadow ray (BENCHMARKS.md,
+    /// "The SAH-optimal 8-wide collapse").
+    Bvh8Sah,
 }
 
 /// How a wide tree is collapsed from the binary one.
@@ -23,11 +27,14 @@ pub enum Collapse {
     PullUp,
     /// Every second level removed.
     EverySecondLevel,
+    /// The cut of least total node area under the surface-area heuristic, by dynamic
+    /// programming (Ylitie et al. 2017's collapse, binary leaves kept whole).
+    Optimal,
 }
 
 impl WideMethod {
     /// Every wide method.
-    pub const ALL: [WideMethod; 3] = [WideMethod::Bvh4, WideMethod::Bvh8, WideMethod::Bvh4Naive];
+    pub const ALL: [WideMethod; 4] = [WideMethod::Bvh4, WideMethod::Bvh8, WideMethod::Bvh4Naive, WideMethod::Bvh8Sah];
 
     /// Command-line name.
     pub fn name(self) -> &'static str {
@@ -35,6 +42,7 @@ impl WideMethod {
             WideMethod::Bvh4 => "bvh4",
             WideMethod::Bvh8 => "bvh8",
             WideMethod::Bvh4Naive => "bvh4-naive",
+            WideMethod::Bvh8Sah => "bvh8-sah",
         }
     }
 
@@ -42,7 +50,7 @@ impl WideMethod {
     pub fn width(self) -> usize {
         match self {
             WideMethod::Bvh4 | WideMethod::Bvh4Naive => 4,
-            WideMethod::Bvh8 => 8,
+            WideMethod::Bvh8 | WideMethod::Bvh8Sah => 8,
         }
     }
 
@@ -50,6 +58,7 @@ impl WideMethod {
     pub fn collapse(self) -> Collapse {
         match self {
             WideMethod::Bvh4 | WideMethod::Bvh8 => Collapse::PullUp,
+            WideMethod::Bvh8Sah => Collapse::Optimal,
             WideMethod::Bvh4Naive => Collapse::EverySecondLevel,
         }
     }

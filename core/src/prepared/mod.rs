@@ -84,6 +84,8 @@ pub struct PreparedScene {
     pub wide8: Option<WideBvh<8>>,
     /// The 4-wide tree with every second level removed ([`WideMethod::Bvh4Naive`]).
     pub wide4_naive: Option<WideBvh<4>>,
+    /// The 8-wide tree by the SAH-optimal cut ([`WideMethod::Bvh8Sah`]).
+    pub wide8_sah: Option<WideBvh<8>>,
     /// The 8-wide tree laid out level by level ([`StreamMethod::Frustum8`]).
     pub levels: Option<LevelBvh>,
     /// Time spent on each part.
@@ -152,11 +154,14 @@ impl PreparedScene {
         timings.kd = seconds_since(Some(t3));
         let t4 = seconds_since(None);
         let wants = |w: WideMethod| methods.contains(&Method::Wide(w));
-        let (wide4, wide8, wide4_naive) = (
+        let (wide4, wide8, wide4_naive, wide8_sah) = (
             wants(WideMethod::Bvh4).then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4.collapse())).transpose()?,
             wants(WideMethod::Bvh8).then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse())).transpose()?,
             wants(WideMethod::Bvh4Naive)
                 .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4Naive.collapse()))
+                .transpose()?,
+            wants(WideMethod::Bvh8Sah)
+                .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8Sah.collapse()))
                 .transpose()?,
         );
         timings.wide = seconds_since(Some(t4));
@@ -181,6 +186,7 @@ impl PreparedScene {
             wide4,
             wide8,
             wide4_naive,
+            wide8_sah,
             levels,
             timings,
             exponent,
@@ -263,6 +269,7 @@ impl PreparedScene {
             WideMethod::Bvh4 => WideTree::Four(self.wide4.as_ref().ok_or_else(missing)?),
             WideMethod::Bvh4Naive => WideTree::Four(self.wide4_naive.as_ref().ok_or_else(missing)?),
             WideMethod::Bvh8 => WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?),
+            WideMethod::Bvh8Sah => WideTree::Eight(self.wide8_sah.as_ref().ok_or_else(missing)?),
         })
     }
 

@@ -25,13 +25,15 @@ pub enum Part {
     Wide8,
     /// The 4-wide tree with every second binary level removed.
     Wide4Naive,
+    /// The 8-wide tree by the SAH-optimal cut.
+    Wide8Sah,
     /// The 8-wide tree stored level by level (the stream method's).
     Levels,
 }
 
 impl Part {
     /// Every part, in the order [`PreparedScene::new`] builds them.
-    pub const ALL: [Part; 9] = [
+    pub const ALL: [Part; 10] = [
         Part::UncleLayout,
         Part::ParentLayout,
         Part::Hash,
@@ -40,6 +42,7 @@ impl Part {
         Part::Wide4,
         Part::Wide8,
         Part::Wide4Naive,
+        Part::Wide8Sah,
         Part::Levels,
     ];
 
@@ -54,6 +57,7 @@ impl Part {
             Part::Wide4 => "4-wide tree",
             Part::Wide8 => "8-wide tree",
             Part::Wide4Naive => "4-wide tree (naive)",
+            Part::Wide8Sah => "8-wide tree (SAH-optimal cut)",
             Part::Levels => "level-order 8-wide tree",
         }
     }
@@ -70,6 +74,7 @@ impl Part {
             Method::Wide(WideMethod::Bvh4) => &[Part::Wide4],
             Method::Wide(WideMethod::Bvh8) => &[Part::Wide8],
             Method::Wide(WideMethod::Bvh4Naive) => &[Part::Wide4Naive],
+            Method::Wide(WideMethod::Bvh8Sah) => &[Part::Wide8Sah],
             Method::Stream(StreamMethod::Frustum8) => &[Part::Levels],
         }
     }
@@ -98,6 +103,7 @@ impl PreparedScene {
             Part::Wide4 => self.wide4.as_ref().map(|t| t.bytes()),
             Part::Wide8 => self.wide8.as_ref().map(|t| t.bytes()),
             Part::Wide4Naive => self.wide4_naive.as_ref().map(|t| t.bytes()),
+            Part::Wide8Sah => self.wide8_sah.as_ref().map(|t| t.bytes()),
             Part::Levels => self.levels.as_ref().map(|t| t.bytes()),
         }
     }
@@ -124,6 +130,7 @@ impl PreparedScene {
                 Part::Wide4 => self.wide4 = None,
                 Part::Wide8 => self.wide8 = None,
                 Part::Wide4Naive => self.wide4_naive = None,
+                Part::Wide8Sah => self.wide8_sah = None,
                 Part::Levels => self.levels = None,
             }
         }

@@ -12,6 +12,8 @@ mod kernel;
 mod memory;
 pub mod network;
 mod node;
+#[cfg(feature = "alloc")]
+mod optimal;
 pub mod traverse;
 #[cfg(feature = "alloc")]
 mod tree;

@@ -1,4 +1,5 @@
 use super::node::{WideChild, WideNode};
+use super::optimal::OptimalCuts;
 use crate::bvh2::{Bvh2, NodeKind, NodeRef};
 use crate::geometry::Triangle;
 use crate::intersect::{TriangleBlock, BLOCK};
@@ -48,11 +49,18 @@ impl<const W: usize> WideBvh<W> {
             return Err(Error::MalformedTree("a wide BVH has 2 to 32 children per node"));
         }
         let leaves_below = leaves_below(bvh);
+        // A leaf of `n` triangles costs its blocks of four, as the SAH builder counts it.
+        let leaf_blocks = |n: u32| match bvh.nodes()[n as usize].kind {
+            NodeKind::Leaf { count, .. } => count.div_ceil(BLOCK as u32) as f32,
+            NodeKind::Internal { .. } => 0.0,
+        };
+        let optimal = (collapse == Collapse::Optimal).then(|| OptimalCuts::solve(bvh, leaf_blocks));
         let mut b = Builder {
             bvh,
             scene: triangles,
             collapse,
             leaves_below,
+            optimal,
             out: WideBvh {
                 nodes: Vec::new(),
                 root: WideChild::Node(0),
@@ -191,6 +199,8 @@ struct Builder<'a, const W: usize> {
     scene: &'a [Triangle],
     collapse: Collapse,
     leaves_below: Vec<u32>,
+    /// The solved cuts, for [`Collapse::Optimal`].
+    optimal: Option<OptimalCuts<W>>,
     out: WideBvh<W>,
 }
 
@@ -269,6 +279,7 @@ impl<const W: usize> Builder<'_, W> {
                 }
                 c = next;
             },
+            Collapse::Optimal => self.optimal.as_ref().map_or(c, |cuts| cuts.slots(self.bvh, n)),
             Collapse::PullUp => {
                 let mut pulled = 0;
                 while c.len() < W {
