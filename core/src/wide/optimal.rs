@@ -52,7 +52,9 @@ impl<const W: usize> OptimalCuts<W> {
                 }
             }
             let own = area + dist[W - 1];
-            node_split[n] = share[W - 1];
+            // At least one slot each side, even where no cost compared (a NaN area): a wide node
+            // never gets more than `W` slots.
+            node_split[n] = share[W - 1].max(1);
             cost[n][0] = own;
             for i in 2..=W {
                 // Ties keep the subtree whole: fewer slots for the same cost.
