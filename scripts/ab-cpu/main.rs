@@ -54,20 +54,22 @@ fn main() {
     let bvh = rc::bvh2::SahBuilder { config: cfg }.build(scene.triangles()).unwrap();
     eprintln!("new tree: {:?}", bvh.stats());
     let m = rc::method::Method::from_name(&method).unwrap_or_else(|| die(format!("unknown method {method}")));
-    let prepared = Arc::new(rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap());
     let newb = rcpu::CpuBackend::with_threads(1).unwrap();
     use rc::trace::Trace;
-    let mut ns = newb.prepare(prepared).unwrap();
+    let new_side =
+        || newb.prepare(Arc::new(rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap())).unwrap();
+    let mut ns = new_side();
     // Old side.
     let omesh = oc::mesh::load(Path::new(path)).unwrap();
     let oscene = omesh.to_scene().unwrap();
     let obvh = oc::bvh2::SahBuilder::default().build(oscene.triangles()).unwrap();
     let om = oc::method::Method::from_name(&method)
         .unwrap_or_else(|| die(format!("{method}: not a method of the old commit")));
-    let oprepared = Arc::new(oc::prepared::PreparedScene::new(&oscene, obvh.clone(), &[om]).unwrap());
     let oldb = ocpu::CpuBackend::with_threads(1).unwrap();
     use oc::trace::Trace as OTrace;
-    let mut os = oldb.prepare(oprepared).unwrap();
+    let old_side =
+        || oldb.prepare(Arc::new(oc::prepared::PreparedScene::new(&oscene, obvh.clone(), &[om]).unwrap())).unwrap();
+    let mut os = old_side();
     // Each round traces fresh copies of both trees (AB_FRESH=0: the same copies throughout): where
     // a process's allocations land in physical memory moved a ray set's time by up to 25% from
     // one run to the next, and fresh copies each round let the median average that out.
@@ -98,8 +100,8 @@ fn main() {
         let (mut tn, mut to) = (Vec::new(), Vec::new());
         for r in 0..rounds + 1 {
             if fresh && r > 0 {
-                os = oldb.prepare(Arc::new(oc::prepared::PreparedScene::new(&oscene, obvh.clone(), &[om]).unwrap())).unwrap();
-                ns = newb.prepare(Arc::new(rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap())).unwrap();
+                os = old_side();
+                ns = new_side();
             }
             let mut run_old = || {
                 let s = Instant::now();
