@@ -1,6 +1,7 @@
-//! The wide-BVH methods' loop for one chunk, monomorphized per width x triangle test x recording,
-//! with the fast child kernel (SIMD box tests, the sorting network), in the AVX2 loop where the
-//! processor has AVX2.
+//! The wide-BVH methods' loop for one chunk, monomorphized per width x memory x triangle test x
+//! recording, with the fast child kernel (SIMD box tests, the sorting network), in the AVX2 loop
+//! where the processor has AVX2. The memory prefetches hit children where that pays (a large tree,
+//! incoherent closest-hit rays: [`worth_prefetching`]).
 
 use crate::chunk::Chunk;
 use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
@@ -10,7 +11,7 @@ use raytrail_core::observe::{Both, Counters, NoObserver, Observer, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
-use raytrail_core::wide::{FastKernel, WideSliceMemory, WideTree};
+use raytrail_core::wide::{worth_prefetching, FastKernel, PrefetchingMemory, WideMemory, WideSliceMemory, WideTree};
 use raytrail_core::{Error, Hit, Ray};
 
 /// Traces one chunk with `method`; returns its counters.
@@ -22,39 +23,52 @@ pub(crate) fn trace_chunk(
 ) -> Result<Counters, Error> {
     let root = scene.wide_root(method)?;
     match scene.wide_tree(method)? {
-        WideTree::Four(t) => WideRun { scene, method, opts, mem: t.memory(), root }.go(chunk),
-        WideTree::Eight(t) => WideRun { scene, method, opts, mem: t.memory(), root }.go(chunk),
+        WideTree::Four(t) => WideRun { scene, method, opts, root }.go(t.memory(), chunk),
+        WideTree::Eight(t) => WideRun { scene, method, opts, root }.go(t.memory(), chunk),
     }
 }
 
-struct WideRun<'a, const W: usize> {
+struct WideRun<'a> {
     scene: &'a PreparedScene,
     method: WideMethod,
     opts: &'a TraceOptions,
-    mem: WideSliceMemory<'a, W>,
     root: WideRoot,
 }
 
-impl<const W: usize> WideRun<'_, W> {
-    fn go(&self, chunk: Chunk<'_>) -> Result<Counters, Error> {
-        match self.opts.triangle_test {
-            TriangleTestKind::Watertight => self.run::<Watertight>(chunk),
-            TriangleTestKind::MollerTrumbore => self.run::<MollerTrumbore>(chunk),
+impl WideRun<'_> {
+    /// Prefetches hit children where that pays ([`worth_prefetching`]).
+    fn go<const W: usize>(&self, mem: WideSliceMemory<'_, W>, chunk: Chunk<'_>) -> Result<Counters, Error> {
+        let bytes = core::mem::size_of_val(mem.nodes) + core::mem::size_of_val(mem.blocks);
+        if worth_prefetching(bytes, chunk.rays, self.opts.query) {
+            self.test(&PrefetchingMemory(mem), chunk)
+        } else {
+            self.test(&mem, chunk)
         }
     }
 
-    fn run<T: TriangleTest>(&self, chunk: Chunk<'_>) -> Result<Counters, Error> {
-        let (mem, root, query) = (&self.mem, self.root, self.opts.query);
+    fn test<const W: usize, M: WideMemory<W>>(&self, mem: &M, chunk: Chunk<'_>) -> Result<Counters, Error> {
+        match self.opts.triangle_test {
+            TriangleTestKind::Watertight => self.run::<W, M, Watertight>(mem, chunk),
+            TriangleTestKind::MollerTrumbore => self.run::<W, M, MollerTrumbore>(mem, chunk),
+        }
+    }
+
+    fn run<const W: usize, M: WideMemory<W>, T: TriangleTest>(
+        &self,
+        mem: &M,
+        chunk: Chunk<'_>,
+    ) -> Result<Counters, Error> {
+        let (root, query) = (self.root, self.opts.query);
         let mut counters = Counters::default();
         match self.opts.record {
-            Record::Nothing => batch::<W, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut NoObserver),
-            Record::Counters => batch::<W, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut counters),
+            Record::Nothing => batch::<W, M, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut NoObserver),
+            Record::Counters => batch::<W, M, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut counters),
             Record::Enumerations => {
                 let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());
                 for ((ray, hit), nodes) in slots {
                     let mut obs = Both(counters, Recorder::default());
                     let (ray, hit) = (core::slice::from_ref(ray), core::slice::from_mut(hit));
-                    batch::<W, T, _>(mem, root, ray, hit, query, &mut obs);
+                    batch::<W, M, T, _>(mem, root, ray, hit, query, &mut obs);
                     counters = obs.0;
                     *nodes = self.scene.canonical_ids(Method::Wide(self.method), obs.1.nodes.iter().copied())?;
                 }
@@ -69,8 +83,8 @@ impl<const W: usize> WideRun<'_, W> {
 /// on x86_64). Every recording mode goes through here, so the conformance suite checks the path
 /// the timings take.
 #[inline(always)]
-fn batch<const W: usize, T: TriangleTest, O: Observer>(
-    mem: &WideSliceMemory<'_, W>,
+fn batch<const W: usize, M: WideMemory<W>, T: TriangleTest, O: Observer>(
+    mem: &M,
     root: WideRoot,
     rays: &[Ray],
     hits: &mut [Hit],
@@ -80,8 +94,8 @@ fn batch<const W: usize, T: TriangleTest, O: Observer>(
     #[cfg(target_arch = "x86_64")]
     if crate::avx::available() {
         // SAFETY: the processor has AVX2 (checked just above).
-        unsafe { crate::avx::trace_batch::<W, _, T, O>(mem, root, rays, hits, query, obs) };
+        unsafe { crate::avx::trace_batch::<W, M, T, O>(mem, root, rays, hits, query, obs) };
         return;
     }
-    trace_wide_batch::<W, _, T, FastKernel, O>(mem, root, rays, hits, query, obs);
+    trace_wide_batch::<W, M, T, FastKernel, O>(mem, root, rays, hits, query, obs);
 }

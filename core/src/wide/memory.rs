@@ -15,6 +15,10 @@ pub trait WideMemory<const W: usize> {
     fn wide_triangle(&self, pos: u32) -> MemRead<'_, [Vec3; 3]>;
     /// The block of four triangles `index` (positions `4 index ..`).
     fn wide_block(&self, index: u32) -> MemRead<'_, TriangleBlock>;
+    /// A hint, right after `node`'s box test, that its hit child `slot` will be visited: memory
+    /// that can bring it closer starts loading it. By default nothing happens.
+    #[inline(always)]
+    fn prefetch_child(&self, _node: &WideNode<W>, _slot: usize) {}
 }
 
 /// A wide tree in plain slices: the CPU backend's memory.

@@ -6,6 +6,8 @@
 //!   binary leaf whole (needs `alloc`);
 //! - [`ChildKernel`]: testing and ordering a node's children, by the plain [`ReferenceKernel`] or
 //!   the [`FastKernel`] (SIMD box tests, the sorting network of [`network`]) that must equal it;
+//! - [`WideMemory`]: what a traversal reads, in plain slices or with the hit children
+//!   prefetched ([`PrefetchingMemory`], for trees larger than the caches);
 //! - [`traverse`]: the state machine.
 
 mod kernel;
@@ -14,6 +16,7 @@ pub mod network;
 mod node;
 #[cfg(feature = "alloc")]
 mod optimal;
+mod prefetch;
 pub mod traverse;
 #[cfg(feature = "alloc")]
 mod tree;
@@ -21,5 +24,6 @@ mod tree;
 pub use kernel::{sort_keys, ChildHits, ChildKernel, FastKernel, ReferenceKernel};
 pub use memory::{WideMemory, WideSliceMemory};
 pub use node::{WideChild, WideNode, EMPTY_CHILD};
+pub use prefetch::{worth_prefetching, PrefetchingMemory, PREFETCH_ABOVE_BYTES};
 #[cfg(feature = "alloc")]
 pub use tree::{WideBvh, WideStats, WideTree};

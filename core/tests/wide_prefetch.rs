@@ -1,0 +1,91 @@
+//! Prefetching the hit children of wide nodes: a hint that changes no answer and no event, taken
+//! only for incoherent closest-hit rays over trees larger than the caches.
+
+use glam::Vec3;
+use raytrail_core::bvh2::{SahBuilder, SahConfig};
+use raytrail_core::intersect::Watertight;
+use raytrail_core::method::{Collapse, Query};
+use raytrail_core::observe::{Both, Counters, Recorder};
+use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
+use raytrail_core::wide::{
+    worth_prefetching, FastKernel, PrefetchingMemory, ReferenceKernel, WideBvh, PREFETCH_ABOVE_BYTES,
+};
+use raytrail_core::{Hit, Ray};
+
+mod common;
+use common::{soup, Rng};
+
+/// Rays from all around the soup in every direction (incoherent), some axis-parallel.
+fn scattered(n: usize, seed: u64) -> Vec<Ray> {
+    let mut r = Rng(seed);
+    (0..n)
+        .map(|i| {
+            let mut d = r.v() - 0.5;
+            if i % 7 == 0 {
+                d = Vec3::new(0.0, d.y, 0.0);
+            }
+            Ray::new(r.v() * 14.0 - 2.0, d, 0.0, if i % 3 == 0 { 5.0 } else { f32::INFINITY })
+        })
+        .collect()
+}
+
+/// A pinhole camera's rays in pixel order (coherent).
+fn camera(n: usize) -> Vec<Ray> {
+    (0..n)
+        .map(|i| {
+            let (x, y) = ((i % 64) as f32 / 64.0 - 0.5, (i / 64) as f32 / 64.0 - 0.5);
+            Ray::new(Vec3::new(5.0, 5.0, -20.0), Vec3::new(x, y, 1.0), 0.0, f32::INFINITY)
+        })
+        .collect()
+}
+
+fn same_as_plain<const W: usize, K: raytrail_core::wide::ChildKernel>(wide: &WideBvh<W>, scale: f32) -> u64 {
+    let root = WideRoot { root: wide.root(), scene_scale: scale, max_steps: u32::MAX };
+    let mut visited = 0;
+    for query in [Query::Closest, Query::Any] {
+        for (i, ray) in scattered(1000, 3 + W as u64).iter().enumerate() {
+            let (mut plain_hit, mut fetched_hit) = ([Hit::MISS], [Hit::MISS]);
+            let mut plain = Both(Counters::default(), Recorder::default());
+            let mut fetched = Both(Counters::default(), Recorder::default());
+            let one = core::slice::from_ref(ray);
+            trace_wide_batch::<W, _, Watertight, K, _>(&wide.memory(), root, one, &mut plain_hit, query, &mut plain);
+            let mem = PrefetchingMemory(wide.memory());
+            trace_wide_batch::<W, _, Watertight, K, _>(&mem, root, one, &mut fetched_hit, query, &mut fetched);
+            let bits = |h: &Hit| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits());
+            assert_eq!(bits(&fetched_hit[0]), bits(&plain_hit[0]), "{query:?} ray {i}: {ray:?}");
+            assert_eq!(fetched.1.nodes, plain.1.nodes, "{query:?} ray {i}: {ray:?}");
+            assert_eq!(fetched.0, plain.0, "{query:?} ray {i}: {ray:?}");
+            visited += plain.0.internal_nodes;
+        }
+    }
+    visited
+}
+
+#[test]
+fn prefetching_changes_no_answer_and_no_event() {
+    let tris = soup(3000, 17, 1.5);
+    let scale = tris.iter().flat_map(|t| t.v).map(|v| v.abs().max_element()).fold(0.0, f32::max);
+    let bvh = SahBuilder::new(SahConfig::default()).build(&tris).unwrap();
+    let w4 = WideBvh::<4>::build(&bvh, &tris, Collapse::PullUp).unwrap();
+    let w8 = WideBvh::<8>::build(&bvh, &tris, Collapse::Optimal).unwrap();
+    let visited = same_as_plain::<4, FastKernel>(&w4, scale)
+        + same_as_plain::<8, FastKernel>(&w8, scale)
+        + same_as_plain::<8, ReferenceKernel>(&w8, scale);
+    assert!(visited > 10_000, "only {visited} internal nodes visited");
+}
+
+#[test]
+fn only_incoherent_closest_hit_rays_over_large_trees_prefetch() {
+    let large = PREFETCH_ABOVE_BYTES + 1;
+    let (scattered, camera) = (scattered(256, 5), camera(256));
+    assert!(worth_prefetching(large, &scattered, Query::Closest));
+    assert!(!worth_prefetching(PREFETCH_ABOVE_BYTES, &scattered, Query::Closest), "a tree that fits the caches");
+    assert!(!worth_prefetching(large, &scattered, Query::Any), "any-hit rays");
+    assert!(!worth_prefetching(large, &camera, Query::Closest), "coherent camera rays");
+    // Too few rays to judge, and degenerate directions (zero, NaN), decide without a panic.
+    assert!(!worth_prefetching(large, &scattered[..1], Query::Closest));
+    assert!(!worth_prefetching(large, &[], Query::Closest));
+    let odd: Vec<Ray> =
+        (0..64).map(|i| Ray::new(Vec3::ZERO, if i % 2 == 0 { Vec3::ZERO } else { Vec3::NAN }, 0.0, 1.0)).collect();
+    assert!(worth_prefetching(large, &odd, Query::Closest), "no pair of these is close");
+}
