@@ -4,7 +4,6 @@
 //! for ray, also when the step budget cuts a ray short.
 
 use raytrail_core::bvh2::NodeRef;
-use raytrail_core::bvh2::{SahBuilder, SahConfig};
 use raytrail_core::intersect::{KdRayContext, NoPair, Watertight};
 use raytrail_core::kd::traverse::{scene_interval, KdRoot, KdStackState};
 use raytrail_core::kd::{KdBuilder, KdSliceMemory};
@@ -16,7 +15,7 @@ use raytrail_core::wide::{FastKernel, ReferenceKernel, WideBvh};
 use raytrail_core::Ray;
 
 mod common;
-use common::{soup, Rng};
+use common::{soup, wide_soup, Rng};
 
 /// Every event, in order.
 #[derive(Debug, Default, PartialEq)]
@@ -84,11 +83,7 @@ fn compare<const W: usize, K: raytrail_core::wide::ChildKernel>(wide: &WideBvh<W
 
 #[test]
 fn run_equals_stepping_the_state_machine() {
-    let tris = soup(4000, 5, 1.5);
-    let scale = tris.iter().flat_map(|t| t.v).map(|v| v.abs().max_element()).fold(0.0, f32::max);
-    let bvh = SahBuilder::new(SahConfig::default()).build(&tris).unwrap();
-    let w4 = WideBvh::<4>::build(&bvh, &tris, Collapse::PullUp).unwrap();
-    let w8 = WideBvh::<8>::build(&bvh, &tris, Collapse::PullUp).unwrap();
+    let (scale, w4, w8) = wide_soup(4000, 5, Collapse::PullUp);
     for max_steps in [u32::MAX, 0, 1, 3, 10] {
         let visited = compare::<4, FastKernel>(&w4, scale, max_steps)
             + compare::<8, FastKernel>(&w8, scale, max_steps)

@@ -2,7 +2,6 @@
 //! only for incoherent closest-hit rays over trees larger than the caches.
 
 use glam::Vec3;
-use raytrail_core::bvh2::{SahBuilder, SahConfig};
 use raytrail_core::intersect::Watertight;
 use raytrail_core::method::{Collapse, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
@@ -13,7 +12,7 @@ use raytrail_core::wide::{
 use raytrail_core::{Hit, Ray};
 
 mod common;
-use common::{soup, Rng};
+use common::{wide_soup, Rng};
 
 /// Rays from all around the soup in every direction (incoherent), some axis-parallel.
 fn scattered(n: usize, seed: u64) -> Vec<Ray> {
@@ -63,11 +62,7 @@ fn same_as_plain<const W: usize, K: raytrail_core::wide::ChildKernel>(wide: &Wid
 
 #[test]
 fn prefetching_changes_no_answer_and_no_event() {
-    let tris = soup(3000, 17, 1.5);
-    let scale = tris.iter().flat_map(|t| t.v).map(|v| v.abs().max_element()).fold(0.0, f32::max);
-    let bvh = SahBuilder::new(SahConfig::default()).build(&tris).unwrap();
-    let w4 = WideBvh::<4>::build(&bvh, &tris, Collapse::PullUp).unwrap();
-    let w8 = WideBvh::<8>::build(&bvh, &tris, Collapse::Optimal).unwrap();
+    let (scale, w4, w8) = wide_soup(3000, 17, Collapse::Optimal);
     let visited = same_as_plain::<4, FastKernel>(&w4, scale)
         + same_as_plain::<8, FastKernel>(&w8, scale)
         + same_as_plain::<8, ReferenceKernel>(&w8, scale);

@@ -54,3 +54,20 @@ pub fn scene_file(file: &str) -> Option<std::path::PathBuf> {
         path.display()
     );
 }
+
+/// A soup of `n` triangles (edges up to 1.5) collapsed 4-wide by the pull-up and 8-wide by
+/// `eight`, with the scene scale (largest coordinate magnitude) traversals need.
+pub fn wide_soup(
+    n: usize,
+    seed: u64,
+    eight: raytrail_core::method::Collapse,
+) -> (f32, raytrail_core::wide::WideBvh<4>, raytrail_core::wide::WideBvh<8>) {
+    use raytrail_core::bvh2::{SahBuilder, SahConfig};
+    use raytrail_core::wide::WideBvh;
+    let tris = soup(n, seed, 1.5);
+    let scale = tris.iter().flat_map(|t| t.v).map(|v| v.abs().max_element()).fold(0.0, f32::max);
+    let bvh = SahBuilder::new(SahConfig::default()).build(&tris).unwrap();
+    let w4 = WideBvh::<4>::build(&bvh, &tris, raytrail_core::method::Collapse::PullUp).unwrap();
+    let w8 = WideBvh::<8>::build(&bvh, &tris, eight).unwrap();
+    (scale, w4, w8)
+}
