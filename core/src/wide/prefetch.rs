@@ -6,7 +6,7 @@
 //! at once lets their misses overlap: the first child's while the children are ordered and pushed,
 //! the pushed ones' while the first child's subtree is traversed. Where the previous ray has
 //! already brought the nodes in (a tree that fits the caches, or coherent rays in pixel order) the
-//! hints only cost instructions: shadow rays lost 7-12%. So the CPU backend prefetches only where
+//! hints only cost instructions: shadow rays lost 12-15%. So the CPU backend prefetches only where
 //! [`worth_prefetching`] says so.
 
 use super::memory::{WideMemory, WideSliceMemory};
@@ -18,8 +18,8 @@ use crate::Ray;
 use glam::Vec3;
 
 /// Trees of more bytes than this (nodes and triangle blocks) may be traversed with prefetching:
-/// half of a 32 MB L3, well above the interiors (4-5 MB) where prefetching never gained, and well
-/// below the 871k-triangle dragon (45 MB) where it did.
+/// half of a 32 MB L3, well above the interiors (4-5 MB) where prefetching gained too little to
+/// take (0.98-1.05 on diffuse rays), and well below the 871k-triangle dragon (45 MB) where it paid.
 pub const PREFETCH_ABOVE_BYTES: usize = 16 << 20;
 
 /// Whether a batch of `rays` answering `query` over a tree of `tree_bytes` (nodes and triangle
@@ -27,12 +27,12 @@ pub const PREFETCH_ABOVE_BYTES: usize = 16 << 20;
 /// larger than [`PREFETCH_ABOVE_BYTES`].
 ///
 /// - Any-hit rays stop at their first occluder, often before the children fetched for them are
-///   visited: on the dragon, ambient-occlusion rays gained 4-7% from outside and lost 3-4% from
+///   visited: on the dragon, ambient-occlusion rays gained 4-8% from outside but 0.96-1.04 from
 ///   inside, so they go without.
 /// - Coherence is judged on up to 32 pairs of neighbouring rays spread over the batch: where at
 ///   least a quarter of them point within about 18 degrees of each other (as neighbouring camera
-///   rays do), the previous ray will have brought the nodes in. Hemisphere-sampled rays pass that
-///   test in about one pair in forty.
+///   rays do), the previous ray will have brought the nodes in. Two directions drawn at random over
+///   a hemisphere pass that test about one time in twenty.
 pub fn worth_prefetching(tree_bytes: usize, rays: &[Ray], query: Query) -> bool {
     if query != Query::Closest || tree_bytes <= PREFETCH_ABOVE_BYTES || rays.len() < 2 {
         return false;
