@@ -7,7 +7,7 @@
 //! two is exact in binary floating point as long as nothing overflows or turns subnormal, and a
 //! ray scaled by the same power (origin and direction both) gives bit for bit the same `t`: every
 //! quantity of the tests scales by a power of two that cancels in `t`. The rays are scaled where a
-//! batch starts ([`super::RayFrame`]); hits need no change.
+//! batch starts ([`super::FramedRays`]); hits need no change.
 
 use crate::bvh2::{Bvh2, Bvh2Node};
 use crate::geometry::Triangle;
