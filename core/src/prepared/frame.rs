@@ -173,12 +173,8 @@ fn surely_kept(ray: &Ray, far: f32, min_dir: f32) -> bool {
 fn min_reliable_dir(scale: f32, far: f32) -> f32 {
     let reach = f64::from(scale) + f64::from(far);
     let bound = reach * reach * reach * (1.0 + 1.0 / 256.0) / f64::from(RELIABLE_LIMIT);
-    let up = bound as f32;
-    if f64::from(up) < bound {
-        f32::from_bits(up.to_bits() + 1)
-    } else {
-        up
-    }
+    // The smallest `f32` not below the bound.
+    -f32_down(-bound)
 }
 
 /// The largest `f32` not above `x` (for `x` within the `f32` range).
