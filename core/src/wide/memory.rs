@@ -15,6 +15,10 @@ pub trait WideMemory<const W: usize> {
     fn wide_triangle(&self, pos: u32) -> MemRead<'_, [Vec3; 3]>;
     /// The block of four triangles `index` (positions `4 index ..`).
     fn wide_block(&self, index: u32) -> MemRead<'_, TriangleBlock>;
+    /// Whether [`WideMemory::prefetch_child`] does anything. The traversal skips its loop over
+    /// the hit slots where it does not: the compiler keeps an empty loop over mask bits, whose
+    /// exit branch depends on the number of children hit.
+    const PREFETCHES: bool = false;
     /// A hint, right after `node`'s box test, that its hit child `slot` will be visited: memory
     /// that can bring it closer starts loading it. By default nothing happens.
     #[inline(always)]

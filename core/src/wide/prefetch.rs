@@ -58,6 +58,8 @@ const LINE: usize = 64;
 pub struct PrefetchingMemory<'a, const W: usize>(pub WideSliceMemory<'a, W>);
 
 impl<const W: usize> WideMemory<W> for PrefetchingMemory<'_, W> {
+    const PREFETCHES: bool = true;
+
     #[inline(always)]
     fn wide_node(&self, index: u32) -> MemRead<'_, WideNode<W>> {
         self.0.wide_node(index)

@@ -167,10 +167,12 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
         return Expanded::NoneHit;
     }
     // As early as the hit children are known, so that their loads overlap the ordering below.
-    let mut m = hits.mask;
-    while m != 0 {
-        mem.prefetch_child(&node, m.trailing_zeros() as usize);
-        m &= m - 1;
+    if M::PREFETCHES {
+        let mut m = hits.mask;
+        while m != 0 {
+            mem.prefetch_child(&node, m.trailing_zeros() as usize);
+            m &= m - 1;
+        }
     }
     let mut order = [0u32; W];
     let n = if q.any && !K::SORTED_ANY {
