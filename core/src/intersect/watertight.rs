@@ -1,7 +1,7 @@
 use super::refine::{needs_refine, refine};
 use super::{BlockHits, TriangleBlock, TriangleHit, TriangleTest};
 use crate::Ray;
-use glam::{Vec3, Vec3A};
+use glam::{BVec3A, Vec3, Vec3A, Vec3Swizzles};
 
 /// The watertight ray/triangle test of Woop, Benthin and Wald (2013), the default.
 ///
@@ -33,27 +33,28 @@ impl TriangleTest for Watertight {
 
     #[inline]
     fn prepare(ray: &Ray) -> ShearedRay {
-        let d = ray.dir();
+        // The permutation by lane selects rather than branches: over scattered directions the
+        // branches mispredicted about every other ray, and indexing by the chosen axis went
+        // through memory.
+        let (d, o) = (Vec3A::from_array(ray.dir), Vec3A::from_array(ray.origin));
         let a = d.abs();
         // Dominant axis; ties go to the lower axis so every backend picks the same one.
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
+        let x_dominant = (a.x >= a.y) & (a.x >= a.z);
+        let y_dominant = !x_dominant & (a.y >= a.z);
+        // The rotation that puts the dominant axis last: (y, z, x), (z, x, y) or (x, y, z).
+        let (on_x, on_y) = (BVec3A::splat(x_dominant), BVec3A::splat(y_dominant));
+        let rotate = |v: Vec3A| Vec3A::select(on_x, v.yzx(), Vec3A::select(on_y, v.zxy(), v));
+        let (d, o) = (rotate(d), rotate(o));
         // Swapping keeps the winding, so the sign of the determinant keeps its meaning.
-        if d[kz] < 0.0 {
-            core::mem::swap(&mut kx, &mut ky);
-        }
-        let dz = d[kz];
-        let o = ray.origin;
+        let negative = d.z < 0.0;
+        let swap = |v: Vec3A| Vec3A::select(BVec3A::splat(negative), v.yxz(), v);
+        let (d, o) = (swap(d), swap(o));
+        let kz = if x_dominant { 0 } else { 2 - usize::from(y_dominant) };
+        let (kx, ky) = ([1, 2, 0][kz], [2, 0, 1][kz]);
+        let (kx, ky) = if negative { (ky, kx) } else { (kx, ky) };
         // `dx/dz, dy/dz, 1/dz` as one 4-wide division where SIMD is available (IEEE per lane).
-        let s = Vec3A::new(d[kx], d[ky], 1.0) / Vec3A::splat(dz);
-        ShearedRay { origin: [o[kx], o[ky], o[kz]], k: [kx, ky, kz], s: s.to_array(), d: [d[kx], d[ky], dz] }
+        let s = d.with_z(1.0) / Vec3A::splat(d.z);
+        ShearedRay { origin: o.to_array(), k: [kx, ky, kz], s: s.to_array(), d: d.to_array() }
     }
 
     #[inline(always)]
