@@ -9,8 +9,11 @@
 // `P.kd_prims`, the triangles in leaf order from `P.kd_tris` (nine words each). WIDE_W comes in
 // the generated header.
 
-// `wide::traverse::WIDE_STACK`.
-const WIDE_STACK: u32 = 448u;
+// Stack entries: `W - 1` postponed children on each of 64 levels, the bound behind
+// `wide::traverse::WIDE_STACK` (which holds the 8-wide case for every width). Sized by the width
+// here because a private array this large lives in local memory, and a 4-wide kernel needs less
+// than half of it; a tree never fills either, so both push exactly the CPU's entries.
+const WIDE_STACK: u32 = (WIDE_W - 1u) * 64u;
 const WIDE_EMPTY: u32 = 0xffffffffu;
 
 // A child: a node index (count 0), or a leaf's first triangle position and count.
@@ -28,7 +31,7 @@ struct WideEntry {
 var<private> WS_CURRENT: WideChild;
 var<private> WS_HAS_CURRENT: bool;
 var<private> WS_LEN: u32;
-var<private> WS_STACK: array<WideEntry, 448>;
+var<private> WS_STACK: array<WideEntry, WIDE_STACK>;
 
 // The reference an observer records (`WideChild::node_ref`).
 fn wide_ref(c: WideChild) -> u32 {
@@ -51,10 +54,12 @@ fn wide_slot(node: u32, i: u32) -> WideSlot {
     return WideSlot(child != WIDE_EMPTY && i < WIDE_W, WideChild(child, count));
 }
 
-// `ChildKernel::test`: each child box by the slab test over the widened interval. WT_ENTER holds
-// the entry distances by slot; WT_T and WT_SLOT are the sort keys (`sort_keys`), which the network
-// reorders.
-var<private> WT_ENTER: array<f32, WIDE_W>;
+// `ChildKernel::test`: each child box by the slab test over the widened interval. WT_T and WT_SLOT
+// are the sort keys (`sort_keys`): by slot after the test, by rank after the network. Every index
+// into them is a constant once the loops over WIDE_W are unrolled, which lets the compiler keep
+// them in registers: a run-time index would send them to local memory, and on an H100 the kernels
+// that indexed them by the hit count and the sorted slot ran at a quarter of the binary stack's
+// speed.
 var<private> WT_T: array<f32, WIDE_W>;
 var<private> WT_SLOT: array<u32, WIDE_W>;
 
@@ -67,8 +72,7 @@ fn wide_test(node: u32, lo_t: f32, hi_t: f32) -> u32 {
             bitcast<f32>(wide_word(node, 4u * WIDE_W + i)), bitcast<f32>(wide_word(node, 5u * WIDE_W + i)));
         let h = slab_hit(lo, hi, lo_t, hi_t);
         // `sort_keys`: a missed child sorts after every hit one.
-        WT_ENTER[i] = select(bitcast<f32>(0x7f800000u), h.t_enter, h.hit);
-        WT_T[i] = WT_ENTER[i];
+        WT_T[i] = select(bitcast<f32>(0x7f800000u), h.t_enter, h.hit);
         WT_SLOT[i] = select(i + WIDE_W, i, h.hit);
         if h.hit {
             mask = mask | (1u << i);
@@ -90,23 +94,35 @@ fn wide_cas(i: u32, j: u32) {
     WT_SLOT[j] = select(sj, si, swap);
 }
 
-// `network::sort_network`: the bitonic network, stage by stage.
+// `network::sort_network`: the bitonic network (Guthe's six compare-and-swaps for four keys),
+// written out pair by pair so that every index is a constant. Any correct network leaves the same
+// order, since the (key, slot) pairs are distinct.
 fn wide_sort() {
-    for (var size = 2u; size <= WIDE_W; size = size * 2u) {
-        for (var i = 0u; i < WIDE_W; i = i + 1u) {
-            let block = i / size * size;
-            let mirror = block + size - 1u - (i - block);
-            if i < mirror {
-                wide_cas(i, mirror);
-            }
-        }
-        for (var d = size / 4u; d >= 1u; d = d / 2u) {
-            for (var i = 0u; i < WIDE_W; i = i + 1u) {
-                if (i & d) == 0u && i + d < WIDE_W {
-                    wide_cas(i, i + d);
-                }
-            }
-        }
+    wide_cas(0u, 1u);
+    wide_cas(2u, 3u);
+    wide_cas(0u, 3u);
+    wide_cas(1u, 2u);
+    wide_cas(0u, 1u);
+    wide_cas(2u, 3u);
+    if WIDE_W == 8u {
+        wide_cas(4u, 5u);
+        wide_cas(6u, 7u);
+        wide_cas(4u, 7u);
+        wide_cas(5u, 6u);
+        wide_cas(4u, 5u);
+        wide_cas(6u, 7u);
+        wide_cas(0u, 7u);
+        wide_cas(1u, 6u);
+        wide_cas(2u, 5u);
+        wide_cas(3u, 4u);
+        wide_cas(0u, 2u);
+        wide_cas(1u, 3u);
+        wide_cas(4u, 6u);
+        wide_cas(5u, 7u);
+        wide_cas(0u, 1u);
+        wide_cas(2u, 3u);
+        wide_cas(4u, 5u);
+        wide_cas(6u, 7u);
     }
 }
 
@@ -169,29 +185,33 @@ fn wide_step() -> u32 {
     if mask == 0u {
         return wide_pop();
     }
-    var n = 0u;
-    if ANY_HIT {
-        // Unsorted: slot order.
-        for (var i = 0u; i < WIDE_W; i = i + 1u) {
-            if (mask & (1u << i)) != 0u {
-                WT_SLOT[n] = i;
-                n = n + 1u;
+    // All hit children but the first pushed, farthest first: for a closest-hit query by rank
+    // after the network, for an any-hit query in descending slot order (unsorted, Sec. 4.2).
+    // Rank and slot run over constants; a miss sorts after every hit, so rank k < n is a hit.
+    // Slot 0 is never pushed: when hit, it is the first.
+    var first_slot = countTrailingZeros(mask);
+    if !ANY_HIT {
+        wide_sort();
+        first_slot = WT_SLOT[0] % WIDE_W;
+    }
+    let n = countOneBits(mask);
+    for (var j = 1u; j < WIDE_W; j = j + 1u) {
+        let k = WIDE_W - j;
+        var slot = k;
+        var push = (mask & (1u << k)) != 0u && k != first_slot;
+        if !ANY_HIT {
+            slot = WT_SLOT[k] % WIDE_W;
+            push = k < n;
+        }
+        if push && WS_LEN < WIDE_STACK {
+            let s = wide_slot(cur.child, slot);
+            if s.ok {
+                WS_STACK[WS_LEN] = WideEntry(s.c.child, s.c.count, WT_T[k]);
+                WS_LEN = WS_LEN + 1u;
             }
         }
-    } else {
-        n = countOneBits(mask);
-        wide_sort();
     }
-    // All but the first, farthest first.
-    for (var k = n - 1u; k >= 1u; k = k - 1u) {
-        let slot = WT_SLOT[k] % WIDE_W;
-        let s = wide_slot(cur.child, slot);
-        if WS_LEN < WIDE_STACK && s.ok {
-            WS_STACK[WS_LEN] = WideEntry(s.c.child, s.c.count, WT_ENTER[slot]);
-            WS_LEN = WS_LEN + 1u;
-        }
-    }
-    let first = wide_slot(cur.child, WT_SLOT[0] % WIDE_W);
+    let first = wide_slot(cur.child, first_slot);
     WS_CURRENT = first.c;
     WS_HAS_CURRENT = first.ok;
     return STEP_CONTINUE;
