@@ -24,11 +24,11 @@ fn is_traceable(r: Ray) -> bool {
 
 // `RayContext::new` for the slab part; returns `is_reliable()`.
 fn ctx_init(r: Ray) -> bool {
-    let reach = P.scene_scale + max_element(abs(r.origin));
+    let reach = P.scene_scale + max_element(abs_bits3(r.origin));
     let inv_dir = div_rn3(vec3<f32>(1.0), r.dir);
-    // 1 / max|d| exactly, as on the CPU: the smallest |1 / d_i|.
-    let inv_abs = abs(inv_dir);
-    let reach_per_d = reach * min(min(inv_abs.x, inv_abs.y), inv_abs.z);
+    // 1 / max|d| exactly, as on the CPU: the smallest |1 / d_i|. It is subnormal for a direction
+    // component near f32::MAX, hence the integer forms.
+    let reach_per_d = reach * min_element_nonneg(abs_bits3(inv_dir));
     var slack = bitcast<f32>(0x7f800000u);
     if reach * reach * reach_per_d < bitcast<f32>(RELIABLE_LIMIT_BITS) {
         slack = reach_per_d * bitcast<f32>(SLACK_SCALE_BITS);

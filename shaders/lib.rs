@@ -242,6 +242,21 @@ pub fn by_name(name: &str) -> Option<Source> {
 
 #[cfg(test)]
 mod tests {
+    /// Kernels take absolute values through `abs_bits` (numerics.wgsl): on an H100 the float
+    /// built-in, or the minimum after it, flushed a subnormal to zero where the CPU keeps it.
+    #[test]
+    fn no_kernel_calls_the_float_abs_builtin() {
+        for s in super::ALL {
+            for (n, line) in s.text.lines().enumerate() {
+                let code = line.split("//").next().unwrap_or("");
+                let call = code
+                    .match_indices("abs(")
+                    .any(|(i, _)| !code[..i].ends_with(|c: char| c.is_alphanumeric() || c == '_'));
+                assert!(!call, "{}:{}: the float abs built-in (use abs_bits): {line}", s.name, n + 1);
+            }
+        }
+    }
+
     #[test]
     fn every_file_is_listed_once_and_found_by_name() {
         for s in super::ALL {

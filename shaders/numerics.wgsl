@@ -13,6 +13,24 @@ fn opq3(v: vec3<f32>) -> vec3<f32> {
     return bitcast<vec3<f32>>(bitcast<vec3<u32>>(v) ^ vec3<u32>(P.zero));
 }
 
+// `|x|` by clearing the sign bit. On an H100 (driver 580) the float absolute value or minimum
+// flushed a subnormal to zero even in SPIR-V kernels that preserve subnormals, which the CPU never
+// does (backends/wgpu/NUMERICS.md, section 3); an integer operation cannot flush.
+fn abs_bits(x: f32) -> f32 {
+    return bitcast<f32>(bitcast<u32>(x) & 0x7fffffffu);
+}
+
+fn abs_bits3(v: vec3<f32>) -> vec3<f32> {
+    return bitcast<vec3<f32>>(bitcast<vec3<u32>>(v) & vec3<u32>(0x7fffffffu));
+}
+
+// The smallest component of a vector of non-negative floats, none NaN, compared as integers: for
+// such floats the bit patterns order as the values do, subnormals included (see `abs_bits`).
+fn min_element_nonneg(v: vec3<f32>) -> f32 {
+    let b = bitcast<vec3<u32>>(v);
+    return bitcast<f32>(min(min(b.x, b.y), b.z));
+}
+
 // `max(acc, x)` keeping `acc` when `x` is NaN or equal (`intersect::keep_max`).
 fn keep_max(acc: f32, x: f32) -> f32 {
     return select(acc, x, x > acc);

@@ -35,7 +35,7 @@ fn segment(r: Ray) -> Segment {
     s.p0 = r.origin + opq3(r.dir * h.t_enter);
     s.p1 = r.origin + opq3(r.dir * h.t_exit);
     s.d = r.dir;
-    s.reach = P.scene_scale + max_element(abs(r.origin));
+    s.reach = P.scene_scale + max_element(abs_bits3(r.origin));
     return s;
 }
 
@@ -61,11 +61,11 @@ fn build(first: u32, end: u32) -> Frustum {
         live = live + 1u;
         lo = glam_min(lo, glam_min(s.p0, s.p1));
         hi = glam_max(hi, glam_max(s.p0, s.p1));
-        let dmax = max_element(abs(s.d));
+        let dmax = max_element(abs_bits3(s.d));
         mean = mean + div_rn3(s.d, vec3<f32>(dmax));
         reach = rust_max(reach, s.reach);
         for (var a = 0u; a < 3u; a = a + 1u) {
-            min_share[a] = rust_min(min_share[a], div_rn(abs(s.d[a]), dmax));
+            min_share[a] = rust_min(min_share[a], div_rn(abs_bits(s.d[a]), dmax));
             // A zero component counts as both signs.
             positive[a] = positive[a] || s.d[a] >= 0.0;
             negative[a] = negative[a] || s.d[a] <= 0.0;

@@ -37,7 +37,7 @@ fn spread2(x: u32) -> u32 {
 
 // `RayGrid::direction_cell`: the cube face, then the Morton-ordered position on it.
 fn direction_cell(d: vec3<f32>) -> u32 {
-    let a = abs(d);
+    let a = abs_bits3(d);
     var axis = 2u;
     if a.x >= a.y && a.x >= a.z {
         axis = 0u;

@@ -23,7 +23,7 @@ struct TriHit {
 }
 
 fn tri_prepare(r: Ray) {
-    let a = abs(r.dir);
+    let a = abs_bits3(r.dir);
     var kz = 2u;
     if a.x >= a.y && a.x >= a.z {
         kz = 0u;
@@ -56,17 +56,17 @@ fn tri_needs_refine(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, ax: f32, ay: f32, 
     let kx = TR.k.x;
     let ky = TR.k.y;
     let kz = TR.k.z;
-    let ma = (abs(a[kx]) + abs(a[ky])) + (abs(a[kz]) + abs(a[kz]));
-    let mb = (abs(b[kx]) + abs(b[ky])) + (abs(b[kz]) + abs(b[kz]));
-    let mc = (abs(c[kx]) + abs(c[ky])) + (abs(c[kz]) + abs(c[kz]));
-    let sa = abs(ax) + abs(ay);
-    let sb = abs(bx) + abs(by);
-    let sc = abs(cx) + abs(cy);
+    let ma = (abs_bits(a[kx]) + abs_bits(a[ky])) + (abs_bits(a[kz]) + abs_bits(a[kz]));
+    let mb = (abs_bits(b[kx]) + abs_bits(b[ky])) + (abs_bits(b[kz]) + abs_bits(b[kz]));
+    let mc = (abs_bits(c[kx]) + abs_bits(c[ky])) + (abs_bits(c[kz]) + abs_bits(c[kz]));
+    let sa = abs_bits(ax) + abs_bits(ay);
+    let sb = abs_bits(bx) + abs_bits(by);
+    let sc = abs_bits(cx) + abs_bits(cy);
     let eu = (opq(mb * sc) + opq(mc * sb)) + opq(sb * sc);
     let ev = (opq(mc * sa) + opq(ma * sc)) + opq(sc * sa);
     let ew = (opq(ma * sb) + opq(mb * sa)) + opq(sa * sb);
-    let lhs = (opq(eu * abs(az - t)) + opq(ev * abs(bz - t))) + opq(ew * abs(cz - t));
-    return lhs > bitcast<f32>(REFINE_SCALE_BITS) * abs(t * det);
+    let lhs = (opq(eu * abs_bits(az - t)) + opq(ev * abs_bits(bz - t))) + opq(ew * abs_bits(cz - t));
+    return lhs > bitcast<f32>(REFINE_SCALE_BITS) * abs_bits(t * det);
 }
 
 // `x - 0` with a zero the compiler cannot see (the uniform `P.zero`): exact, the sign of a zero
