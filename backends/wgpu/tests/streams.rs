@@ -80,7 +80,7 @@ fn streams_persistent_threads_and_workgroup_sizes_give_the_same_hits_and_counter
     let (scene, rays) = scene_and_rays(&backend, &generated_scene("shared_edge_grid"));
     // Persistent threads in workgroups of 32 over small streamed batches run the whole suite in
     // conformance_persistent.rs; on lavapipe each workgroup size is every kernel compiled again
-    // (about a second each), so this test adds one other size rather than repeating that one.
+    // (0.3 to 4 seconds each), so this test adds one other size rather than repeating that one.
     let configs = [
         GpuConfig { batch_rays: 1000, in_flight: 2, ..GpuConfig::default() },
         GpuConfig { batch_rays: 777, in_flight: 3, dispatch: Dispatch::PERSISTENT, workgroup_size: 256 },
