@@ -4,6 +4,8 @@
 //! Rays: primary rays of the bench's outside or inside view (the conformance suite's
 //! `Camera::inside`, as the bench's), their diffuse bounces, shadow rays to the default light,
 //! and ambient-occlusion rays (the bounces cut to 5% of the scene's diagonal).
+mod packet;
+
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -59,6 +61,18 @@ fn main() {
     let new_side =
         || newb.prepare(Arc::new(rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap())).unwrap();
     let mut ns = new_side();
+    let pscene = rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap();
+    // AB_PACKET=1 or =ia: the new side is the packet prototype (packet.rs), not the library's method.
+    let packet_mode = std::env::var("AB_PACKET").ok();
+    let packet_rays: usize = std::env::var("AB_PACKET_RAYS").ok().and_then(|v| v.parse().ok()).unwrap_or(8);
+    let packet_tree = match (&packet_mode, m) {
+        (None, _) => None,
+        (Some(_), rc::method::Method::Wide(wm)) => match pscene.wide_tree(wm) {
+            Ok(rc::wide::WideTree::Eight(t)) => Some((t, pscene.wide_root(wm).unwrap_or_else(|e| die(e.to_string())))),
+            _ => die(format!("AB_PACKET needs an 8-wide method, not {method}")),
+        },
+        (Some(_), _) => die(format!("AB_PACKET needs an 8-wide method, not {method}")),
+    };
     // Old side.
     let omesh = oc::mesh::load(Path::new(path)).unwrap();
     let oscene = omesh.to_scene().unwrap();
@@ -77,7 +91,18 @@ fn main() {
 
     let bounds = scene.bounds();
     let cam = if view == "inside" { conf::rays::Camera::inside(bounds) } else { conf::rays::Camera::framing(bounds) };
-    let prim = conf::rays::primary_from(&cam, w, h);
+    let mut prim = conf::rays::primary_from(&cam, w, h);
+    // AB_TILES=1: the camera rays (and so the rays made from their hits) in tiles of 8 x 8 pixels,
+    // the tiles in row order, as a tiled renderer hands them over.
+    if std::env::var("AB_TILES").is_ok() && w % 8 == 0 && h % 8 == 0 {
+        let (w, h) = (w as usize, h as usize);
+        let tile = |i: usize| {
+            let (t, k) = (i / 64, i % 64);
+            let (tx, ty) = (t % (w / 8), t / (w / 8));
+            (ty * 8 + k / 8) * w + tx * 8 + k % 8
+        };
+        prim = (0..w * h).map(|i| prim[tile(i)]).collect();
+    }
     let mut hits = vec![rc::Hit::MISS; prim.len()];
     newb.trace(&ns, &prim, &rc::trace::TraceOptions::new(m), &mut hits).unwrap();
     let diff = conf::rays::diffuse(&prim, &hits, &scene, conf::rays::RAY_SEED);
@@ -110,7 +135,13 @@ fn main() {
             };
             let mut run_new = || {
                 let s = Instant::now();
-                newb.trace(&ns, rays, &nopts, &mut nh).unwrap();
+                if let (Some(mode), Some((t, root))) = (&packet_mode, &packet_tree) {
+                    let framed = pscene.frame_rays(rays);
+                    packet::trace(&t.memory(), *root, framed.rays(), &mut nh, q, mode == "ia", packet_rays);
+                    framed.finish(&mut nh);
+                } else {
+                    newb.trace(&ns, rays, &nopts, &mut nh).unwrap();
+                }
                 s.elapsed().as_secs_f64()
             };
             let (a, b) = if r % 2 == 0 {
