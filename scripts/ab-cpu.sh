@@ -10,15 +10,16 @@
 # Environment: AB_SIZE=WxH (primary rays, default 384x288); AB_TILES=1 orders the camera rays in
 # tiles of 8 x 8 pixels; AB_PACKET=1 or ia makes the new side the packet prototype of
 # scripts/ab-cpu/packet.rs (ia: with its interval cull; METHOD an 8-wide one), AB_PACKET_RAYS=8, 16,
-# 32 or 64 rays per packet (8 by default); AB_TRAV, AB_MAXLEAF, AB_BLOCK, AB_BINS change the new side's SAH settings (to try a
-# builder change without editing it); AB_FRESH=0 keeps one copy of each tree for all rounds (by
-# default each round traces fresh copies, so that where the trees land in physical memory, which
-# moved a set by up to 25% between runs, averages out).
+# 32 or 64 rays per packet (8 by default), AB_PACKET_LEAVES=1 its leaves tested a triangle against
+# eight rays at a time; AB_TRAV, AB_MAXLEAF, AB_BLOCK, AB_BINS change the new side's SAH settings
+# (to try a builder change without editing it); AB_FRESH=0 keeps one copy of each tree for all
+# rounds (by default each round traces fresh copies, so that where the trees land in physical
+# memory, which moved a set by up to 25% between runs, averages out).
 # The old commit is checked out in a temporary worktree with its two crates renamed, so both link
 # into one binary.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 2 ] || { sed -n 2,18p "$0"; exit 2; }
+[ $# -ge 2 ] || { sed -n 2,19p "$0"; exit 2; }
 rev=$1; shift
 old=$(mktemp -d /tmp/raytrail-ab-old.XXXXXX)
 trap 'git -C "$root" worktree remove --force "$old" >/dev/null 2>&1 || true' EXIT

@@ -64,6 +64,7 @@ fn main() {
     let pscene = rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap();
     // AB_PACKET=1 or =ia: the new side is the packet prototype (packet.rs), not the library's method.
     let packet_mode = std::env::var("AB_PACKET").ok();
+    let packet_leaves = std::env::var("AB_PACKET_LEAVES").is_ok();
     let packet_rays: usize = std::env::var("AB_PACKET_RAYS").ok().and_then(|v| v.parse().ok()).unwrap_or(8);
     let packet_tree = match (&packet_mode, m) {
         (None, _) => None,
@@ -137,7 +138,16 @@ fn main() {
                 let s = Instant::now();
                 if let (Some(mode), Some((t, root))) = (&packet_mode, &packet_tree) {
                     let framed = pscene.frame_rays(rays);
-                    packet::trace(&t.memory(), *root, framed.rays(), &mut nh, q, mode == "ia", packet_rays);
+                    packet::trace(
+                        &t.memory(),
+                        *root,
+                        framed.rays(),
+                        &mut nh,
+                        q,
+                        mode == "ia",
+                        packet_rays,
+                        packet_leaves,
+                    );
                     framed.finish(&mut nh);
                 } else {
                     newb.trace(&ns, rays, &nopts, &mut nh).unwrap();
