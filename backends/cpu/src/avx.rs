@@ -1,7 +1,8 @@
 //! The AVX2 path of the wide traversal, chosen at run time: an 8-wide node's boxes in one 256-bit
-//! operation per step, and the whole batch loop compiled for AVX2 (so the 4-wide SSE code and the
-//! triangle tests get its three-operand encoding too). Every answer is the reference kernel's bit
-//! for bit; the test below holds it to that on adversarial values.
+//! operation per step, three or more hit children ordered by rank, and the whole batch loop
+//! compiled for AVX2 (so the 4-wide SSE code and the triangle tests get its three-operand encoding
+//! too). Every answer and every order is the reference kernel's bit for bit; the tests below hold
+//! them to that on adversarial values.
 
 use raytrail_core::intersect::{SlabRay, TriangleTest, FAR_PAD};
 use raytrail_core::method::Query;
@@ -10,9 +11,11 @@ use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{ChildHits, ChildKernel, FastKernel, WideMemory, WideNode};
 use raytrail_core::{Hit, Ray};
 use std::arch::x86_64::{
-    _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps, _mm256_blendv_ps, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_max_ps,
-    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
-    _CMP_LE_OQ,
+    _mm256_add_epi32, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_ps,
+    _mm256_castps_si256, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_max_ps,
+    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps,
+    _mm256_setr_epi32, _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps,
+    _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
 };
 
 /// Whether this processor runs the AVX2 path.
@@ -20,7 +23,8 @@ pub(crate) fn available() -> bool {
     std::arch::is_x86_feature_detected!("avx2")
 }
 
-/// The fast kernel with 8-wide nodes tested in one AVX operation per plane. Private to this
+/// The fast kernel with 8-wide nodes tested in one AVX operation per plane and ordered by
+/// [`order_by_rank`] where three or more children are hit. Private to this
 /// module and used only inside [`trace_batch`], whose caller has checked for AVX2: that is what
 /// makes its unchecked AVX calls sound (a check per node cost 2% of a ray's time).
 struct AvxKernel;
@@ -40,7 +44,12 @@ impl ChildKernel for AvxKernel {
 
     #[inline(always)]
     fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
-        FastKernel::order(hits, order)
+        if W == 8 && hits.mask.count_ones() > 2 {
+            // SAFETY: only `trace_batch` uses this kernel, and only on a processor with AVX2.
+            unsafe { order_by_rank(hits, order) }
+        } else {
+            FastKernel::order(hits, order)
+        }
     }
 }
 
@@ -83,6 +92,49 @@ unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, t
     out
 }
 
+/// Three or more hit children of an 8-wide node ordered without a branch: each child's rank is
+/// the number of children before it in the order (entry distance, then slot; a missed child's key
+/// is `+inf` and its slot counts as `slot + 8`, so it ranks after every hit one), counted by eight
+/// vector comparisons, and the child is written at its rank. The order is the sorting network's
+/// and the reference's insertion sort's, since all three sort by the same total order; the
+/// network compiled to two branches per compare-and-swap here.
+///
+/// # Safety
+/// The processor must support AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn order_by_rank<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
+    if W != 8 {
+        // The loads below read eight lanes.
+        return FastKernel::order(hits, order);
+    }
+    let keys = _mm256_loadu_ps(hits.t_enter.as_ptr());
+    let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let hit_bits =
+        _mm256_and_si256(_mm256_set1_epi32(hits.mask as i32), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128));
+    let missed = _mm256_cmpeq_epi32(hit_bits, _mm256_setzero_si256());
+    let slots = _mm256_add_epi32(lanes, _mm256_and_si256(missed, _mm256_set1_epi32(8)));
+    let (mut k, mut s) = ([0f32; 8], [0i32; 8]);
+    _mm256_storeu_ps(k.as_mut_ptr(), keys);
+    _mm256_storeu_si256(s.as_mut_ptr().cast(), slots);
+    let mut rank = _mm256_setzero_si256();
+    for j in 0..8 {
+        let (kj, sj) = (_mm256_set1_ps(k[j]), _mm256_set1_epi32(s[j]));
+        let less = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LT_OQ>(kj, keys));
+        let tie =
+            _mm256_and_si256(_mm256_castps_si256(_mm256_cmp_ps::<_CMP_EQ_OQ>(kj, keys)), _mm256_cmpgt_epi32(slots, sj));
+        // A comparison that holds is all ones, -1: subtracting it counts it.
+        rank = _mm256_sub_epi32(rank, _mm256_or_si256(less, tie));
+    }
+    let mut r = [0u32; 8];
+    _mm256_storeu_si256(r.as_mut_ptr().cast(), rank);
+    for (slot, &at) in r.iter().enumerate() {
+        // Ranks are a permutation of 0..8 (the order is total over distinct slots).
+        order[at as usize % W] = slot as u32;
+    }
+    hits.mask.count_ones() as usize
+}
+
 /// [`trace_wide_batch`] with [`AvxKernel`], compiled for AVX2.
 ///
 /// # Safety
@@ -103,7 +155,7 @@ pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: T
 mod tests {
     use super::*;
     use glam::Vec3;
-    use raytrail_core::wide::{ReferenceKernel, WideChild};
+    use raytrail_core::wide::{ChildHits, ReferenceKernel, WideChild};
 
     /// Ordinary values with zeros of both signs, infinities, NaN, a subnormal and exact repeats.
     struct Values(u64);
@@ -157,7 +209,28 @@ mod tests {
                 "{ray:?} {node:?}"
             );
             hits += r.mask.count_ones();
+            let (mut oa, mut or) = ([0; 8], [0; 8]);
+            let (na, nr) = (AvxKernel::order(&a, &mut oa), ReferenceKernel::order(&r, &mut or));
+            assert_eq!((na, &oa[..na]), (nr, &or[..nr]), "{:?}", r.t_enter);
         }
         assert!(hits > 20_000, "only {hits} child hits");
+    }
+
+    /// The rank order on ties: equal keys (zeros of both signs among them) keep slot order, and
+    /// every count of hit children from three to eight.
+    #[test]
+    fn rank_order_matches_the_reference_on_ties() {
+        if !available() {
+            eprintln!("SKIPPED the AVX2 order test: this processor has no AVX2");
+            return;
+        }
+        let keys = [0.0, -0.0, 1.0, 1.0, 0.5, 0.0, 1.0, -0.0];
+        for mask in 0u32..256 {
+            let t_enter = core::array::from_fn(|i| if mask & (1 << i) != 0 { keys[i] } else { f32::INFINITY });
+            let hits = ChildHits::<8> { t_enter, mask };
+            let (mut oa, mut or) = ([0; 8], [0; 8]);
+            let (na, nr) = (AvxKernel::order(&hits, &mut oa), ReferenceKernel::order(&hits, &mut or));
+            assert_eq!((na, &oa[..na]), (nr, &or[..nr]), "mask {mask:#b}");
+        }
     }
 }
