@@ -57,7 +57,8 @@ pub fn to_svg(r: &BenchReport) -> String {
             if r.passes == 1 { "" } else { "es" }
         ),
     );
-    legend(&mut svg, 10.0, 40.0, &r.baseline);
+    let present = |k: TargetKind| r.scenes.iter().flat_map(|s| &s.rays).flat_map(|x| &x.rows).any(|row| row.kind == k);
+    legend(&mut svg, 10.0, 40.0, &r.baseline, present);
     let mut y = TOP;
     for (s, h) in r.scenes.iter().zip(&heights) {
         panel(&mut svg, s, y, &r.threads, &r.baseline);
@@ -78,22 +79,31 @@ fn colour(kind: TargetKind) -> &'static str {
     match kind {
         TargetKind::RaytrailBvh2 => "#1f6fb4",
         TargetKind::RaytrailKd => "#2a9d4b",
+        TargetKind::RaytrailWide => "#17a5b8",
+        TargetKind::RaytrailStream => "#8c5a3c",
+        TargetKind::RaytrailAuto => "#555555",
         TargetKind::RaytrailGpu => "#7b3fa0",
         TargetKind::PeerOwnTest => "#e8770e",
         TargetKind::PeerWatertight => "#b2403a",
     }
 }
 
-/// The legend of target groups and the baseline line.
-fn legend(svg: &mut String, x: f64, y: f64, baseline: &str) {
+/// The legend of the target groups the run has, and the baseline line.
+fn legend(svg: &mut String, x: f64, y: f64, baseline: &str, present: impl Fn(TargetKind) -> bool) {
     let mut x = x;
     for (kind, label) in [
         (TargetKind::RaytrailBvh2, "raytrail BVH2 methods"),
         (TargetKind::RaytrailKd, "raytrail kd methods"),
+        (TargetKind::RaytrailWide, "raytrail wide methods"),
+        (TargetKind::RaytrailStream, "raytrail stream"),
+        (TargetKind::RaytrailAuto, "raytrail auto"),
         (TargetKind::RaytrailGpu, "raytrail on the GPU (wgpu)"),
         (TargetKind::PeerOwnTest, "peer, own triangle test"),
         (TargetKind::PeerWatertight, "peer + raytrail watertight test (+wt)"),
     ] {
+        if !present(kind) {
+            continue;
+        }
         let _ =
             write!(svg, r##"<rect x="{x:.1}" y="{:.1}" width="12" height="10" fill="{}"/>"##, y - 9.0, colour(kind));
         text(svg, x + 16.0, y, "start", 11.0, false, label);

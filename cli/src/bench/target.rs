@@ -16,6 +16,12 @@ pub enum TargetKind {
     RaytrailBvh2,
     /// A raytrail method over the kd-tree.
     RaytrailKd,
+    /// A raytrail method over a wide BVH.
+    RaytrailWide,
+    /// raytrail's ray-stream method.
+    RaytrailStream,
+    /// raytrail's `--method auto`: a method chosen per batch.
+    RaytrailAuto,
     /// A raytrail method on the GPU (wgpu backend).
     RaytrailGpu,
     /// A peer library with its own triangle test.
@@ -30,6 +36,9 @@ impl TargetKind {
         match self {
             TargetKind::RaytrailBvh2 => "raytrail-bvh2",
             TargetKind::RaytrailKd => "raytrail-kd",
+            TargetKind::RaytrailWide => "raytrail-wide",
+            TargetKind::RaytrailStream => "raytrail-stream",
+            TargetKind::RaytrailAuto => "raytrail-auto",
             TargetKind::RaytrailGpu => "raytrail-gpu",
             TargetKind::PeerOwnTest => "peer",
             TargetKind::PeerWatertight => "peer-watertight",
@@ -38,7 +47,14 @@ impl TargetKind {
 
     /// Whether the target is one of raytrail's CPU methods (what the speed target compares).
     pub fn is_raytrail(self) -> bool {
-        matches!(self, TargetKind::RaytrailBvh2 | TargetKind::RaytrailKd)
+        matches!(
+            self,
+            TargetKind::RaytrailBvh2
+                | TargetKind::RaytrailKd
+                | TargetKind::RaytrailWide
+                | TargetKind::RaytrailStream
+                | TargetKind::RaytrailAuto
+        )
     }
 
     /// Whether the target is a peer library.
@@ -173,6 +189,8 @@ impl BenchTarget for RaytrailCpu {
     fn kind(&self) -> TargetKind {
         match self.method.structure() {
             Structure::Kd => TargetKind::RaytrailKd,
+            Structure::Wide => TargetKind::RaytrailWide,
+            Structure::Levels => TargetKind::RaytrailStream,
             _ => TargetKind::RaytrailBvh2,
         }
     }

@@ -63,7 +63,7 @@ impl BenchTarget for AutoTarget {
     }
 
     fn kind(&self) -> TargetKind {
-        TargetKind::RaytrailBvh2
+        TargetKind::RaytrailAuto
     }
 
     fn trace(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<(), String> {
