@@ -8,14 +8,14 @@ use raytrail_core::intersect::{SlabRay, TriangleTest, FAR_PAD};
 use raytrail_core::method::Query;
 use raytrail_core::observe::Observer;
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
-use raytrail_core::wide::{ChildHits, ChildKernel, FastKernel, WideMemory, WideNode};
+use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideMemory, WideNode};
 use raytrail_core::{Hit, Ray};
 use std::arch::x86_64::{
-    _mm256_add_epi32, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_ps,
-    _mm256_castps_si256, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_max_ps,
-    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps,
-    _mm256_setr_epi32, _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps,
-    _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
+    _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_ps, _mm256_castps_si256,
+    _mm256_cmp_ps, _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps,
+    _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps,
+    _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps, _CMP_EQ_OQ,
+    _CMP_LE_OQ, _CMP_LT_OQ,
 };
 
 /// Whether this processor runs the AVX2 path.
@@ -93,8 +93,8 @@ unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, t
 }
 
 /// Three or more hit children of an 8-wide node ordered without a branch: each child's rank is
-/// the number of children before it in the order (entry distance, then slot; a missed child's key
-/// is `+inf` and its slot counts as `slot + 8`, so it ranks after every hit one), counted by eight
+/// the number of children before it in the order of [`sort_keys`] (entry distance, then slot; a
+/// missed child ranks after every hit one), counted by eight
 /// vector comparisons, and the child is written at its rank. The order is the sorting network's
 /// and the reference's insertion sort's, since all three sort by the same total order; the
 /// network compiled to two branches per compare-and-swap here.
@@ -108,18 +108,14 @@ unsafe fn order_by_rank<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W
         // The loads below read eight lanes.
         return FastKernel::order(hits, order);
     }
-    let keys = _mm256_loadu_ps(hits.t_enter.as_ptr());
-    let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    let hit_bits =
-        _mm256_and_si256(_mm256_set1_epi32(hits.mask as i32), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128));
-    let missed = _mm256_cmpeq_epi32(hit_bits, _mm256_setzero_si256());
-    let slots = _mm256_add_epi32(lanes, _mm256_and_si256(missed, _mm256_set1_epi32(8)));
-    let (mut k, mut s) = ([0f32; 8], [0i32; 8]);
-    _mm256_storeu_ps(k.as_mut_ptr(), keys);
-    _mm256_storeu_si256(s.as_mut_ptr().cast(), slots);
+    // The sort keys every kernel orders by: slots count as integers below 16, so the signed
+    // comparison of their bits is theirs.
+    let (k, s) = sort_keys(hits);
+    let keys = _mm256_loadu_ps(k.as_ptr());
+    let slots = _mm256_loadu_si256(s.as_ptr().cast());
     let mut rank = _mm256_setzero_si256();
     for j in 0..8 {
-        let (kj, sj) = (_mm256_set1_ps(k[j]), _mm256_set1_epi32(s[j]));
+        let (kj, sj) = (_mm256_set1_ps(k[j]), _mm256_set1_epi32(s[j] as i32));
         let less = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LT_OQ>(kj, keys));
         let tie =
             _mm256_and_si256(_mm256_castps_si256(_mm256_cmp_ps::<_CMP_EQ_OQ>(kj, keys)), _mm256_cmpgt_epi32(slots, sj));
@@ -155,7 +151,7 @@ pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: T
 mod tests {
     use super::*;
     use glam::Vec3;
-    use raytrail_core::wide::{ChildHits, ReferenceKernel, WideChild};
+    use raytrail_core::wide::{ReferenceKernel, WideChild};
 
     /// Ordinary values with zeros of both signs, infinities, NaN, a subnormal and exact repeats.
     struct Values(u64);
