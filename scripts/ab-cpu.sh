@@ -8,11 +8,9 @@
 #   scripts/ab-cpu.sh OLD_REV SCENE [VIEW=inside] [METHOD=bvh8] [ROUNDS=15] [SETS=primary,shadow,diffuse,ao]
 #
 # Environment: AB_SIZE=WxH (primary rays, default 384x288); AB_TILES=1 orders the camera rays in
-# tiles of 8 x 8 pixels; AB_PACKET=1 or ia makes the new side the packet prototype of
-# scripts/ab-cpu/packet.rs (ia: with its interval cull; METHOD an 8-wide one), AB_PACKET_RAYS=8, 16,
-# 32 or 64 rays per packet (8 by default), AB_PACKET_LEAVES=1 its leaves tested a triangle against
-# eight rays at a time; AB_TRAV, AB_MAXLEAF, AB_BLOCK, AB_BINS change the new side's SAH settings
-# (to try a builder change without editing it); AB_FRESH=0 keeps one copy of each tree for all
+# tiles of 8 x 8 pixels; AB_NEW_METHOD=NAME makes the new side trace with another method (say
+# bvh8-packet against the old side's bvh8); AB_TRAV, AB_MAXLEAF, AB_BLOCK, AB_BINS change the new
+# side's SAH settings (to try a builder change without editing it); AB_FRESH=0 keeps one copy of each tree for all
 # rounds (by default each round traces fresh copies, so that where the trees land in physical
 # memory, which moved a set by up to 25% between runs, averages out).
 # The old commit is checked out in a temporary worktree with its two crates renamed, so both link
@@ -29,7 +27,7 @@ sed -i 's/^name = "raytrail-cpu"/name = "raytrail-cpu-old"/' "$old/backends/cpu/
 sed -i -E 's|^(raytrail-core = \{ path = "core",[^}]*)\}|\1, package = "raytrail-core-old" }|; s|^(raytrail-cpu = \{ path = "backends/cpu",[^}]*)\}|\1, package = "raytrail-cpu-old" }|' "$old/Cargo.toml"
 harness=$(mktemp -d /tmp/raytrail-ab-harness.XXXXXX)
 mkdir -p "$harness/src"
-cp "$root/scripts/ab-cpu/main.rs" "$root/scripts/ab-cpu/packet.rs" "$harness/src/"
+cp "$root/scripts/ab-cpu/main.rs" "$harness/src/"
 cat > "$harness/Cargo.toml" <<TOML
 [package]
 name = "raytrail-ab"

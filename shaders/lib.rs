@@ -180,6 +180,9 @@ pub const TRIANGLE_WATERTIGHT: Source =
 /// `wide.wgsl`.
 pub const WIDE: Source = Source { name: "wide.wgsl", text: include_str!("wide.wgsl") };
 
+/// `wide_packet.wgsl`.
+pub const WIDE_PACKET: Source = Source { name: "wide_packet.wgsl", text: include_str!("wide_packet.wgsl") };
+
 /// Every file, in name order.
 pub const ALL: &[Source] = &[
     BOX,
@@ -233,6 +236,7 @@ pub const ALL: &[Source] = &[
     TRIANGLE_MOLLER_TRUMBORE,
     TRIANGLE_WATERTIGHT,
     WIDE,
+    WIDE_PACKET,
 ];
 
 /// The file of `name` (for example `"box.wgsl"`), if there is one.

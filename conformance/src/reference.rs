@@ -12,6 +12,7 @@ use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::stream::{trace_stream_with, FrustumCull, Serial};
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
+use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{ReferenceKernel, WideSliceMemory, WideTree};
 use raytrail_core::{Error, Hit, Ray};
@@ -77,8 +78,8 @@ impl SerialBackend {
             Method::Wide(m) => {
                 let root = scene.wide_root(m)?;
                 match scene.wide_tree(m)? {
-                    WideTree::Four(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query)),
-                    WideTree::Eight(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query)),
+                    WideTree::Four(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query, m.packets())),
+                    WideTree::Eight(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query, m.packets())),
                 }
             }
             other => Err(Error::Unsupported { method: other.name(), by: "the serial reference backend" }),
@@ -88,13 +89,32 @@ impl SerialBackend {
 
 impl SerialBackend {
     /// Wide trees with the reference kernel (one child box at a time, an insertion sort): the
-    /// scalar traversal every fast path's enumeration must equal.
+    /// scalar traversal every fast path's enumeration must equal. With `packets`, in the packets
+    /// of the grouping, each ray's box tests one child at a time ([`ReferencePacketKernel`]).
     fn wide<const W: usize, T: TriangleTest>(
         mem: &WideSliceMemory<'_, W>,
         root: WideRoot,
         rays: &[Ray],
         query: Query,
+        packets: bool,
     ) -> Vec<Traced> {
+        if packets {
+            let mut out: Vec<Traced> = (0..rays.len()).map(|_| (Hit::MISS, Default::default())).collect();
+            let mut hits = vec![Hit::MISS; rays.len()];
+            let mut observers = Vec::with_capacity(rays.len());
+            trace_wide_packets::<W, _, T, ReferenceKernel, ReferencePacketKernel, Both<Counters, Recorder>>(
+                mem,
+                root,
+                rays,
+                &mut hits,
+                query,
+                |i, o| observers.push((i, o)),
+            );
+            for (i, o) in observers {
+                out[i] = (hits[i], o);
+            }
+            return out;
+        }
         rays.iter()
             .map(|ray| {
                 let mut o = Both(Counters::default(), Recorder::default());

@@ -4,7 +4,6 @@
 //! Rays: primary rays of the bench's outside or inside view (the conformance suite's
 //! `Camera::inside`, as the bench's), their diffuse bounces, shadow rays to the default light,
 //! and ambient-occlusion rays (the bounces cut to 5% of the scene's diagonal).
-mod packet;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -55,25 +54,15 @@ fn main() {
     }
     let bvh = rc::bvh2::SahBuilder { config: cfg }.build(scene.triangles()).unwrap();
     eprintln!("new tree: {:?}", bvh.stats());
-    let m = rc::method::Method::from_name(&method).unwrap_or_else(|| die(format!("unknown method {method}")));
+    // AB_NEW_METHOD=NAME: the new side traces with another method than the old (bvh8-packet
+    // against bvh8, say); its hits must still be the old method's.
+    let new_method = std::env::var("AB_NEW_METHOD").unwrap_or_else(|_| method.clone());
+    let m = rc::method::Method::from_name(&new_method).unwrap_or_else(|| die(format!("unknown method {new_method}")));
     let newb = rcpu::CpuBackend::with_threads(1).unwrap();
     use rc::trace::Trace;
     let new_side =
         || newb.prepare(Arc::new(rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap())).unwrap();
     let mut ns = new_side();
-    let pscene = rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap();
-    // AB_PACKET=1 or =ia: the new side is the packet prototype (packet.rs), not the library's method.
-    let packet_mode = std::env::var("AB_PACKET").ok();
-    let packet_leaves = std::env::var("AB_PACKET_LEAVES").is_ok();
-    let packet_rays: usize = std::env::var("AB_PACKET_RAYS").ok().and_then(|v| v.parse().ok()).unwrap_or(8);
-    let packet_tree = match (&packet_mode, m) {
-        (None, _) => None,
-        (Some(_), rc::method::Method::Wide(wm)) => match pscene.wide_tree(wm) {
-            Ok(rc::wide::WideTree::Eight(t)) => Some((t, pscene.wide_root(wm).unwrap_or_else(|e| die(e.to_string())))),
-            _ => die(format!("AB_PACKET needs an 8-wide method, not {method}")),
-        },
-        (Some(_), _) => die(format!("AB_PACKET needs an 8-wide method, not {method}")),
-    };
     // Old side.
     let omesh = oc::mesh::load(Path::new(path)).unwrap();
     let oscene = omesh.to_scene().unwrap();
@@ -136,22 +125,7 @@ fn main() {
             };
             let mut run_new = || {
                 let s = Instant::now();
-                if let (Some(mode), Some((t, root))) = (&packet_mode, &packet_tree) {
-                    let framed = pscene.frame_rays(rays);
-                    packet::trace(
-                        &t.memory(),
-                        *root,
-                        framed.rays(),
-                        &mut nh,
-                        q,
-                        mode == "ia",
-                        packet_rays,
-                        packet_leaves,
-                    );
-                    framed.finish(&mut nh);
-                } else {
-                    newb.trace(&ns, rays, &nopts, &mut nh).unwrap();
-                }
+                newb.trace(&ns, rays, &nopts, &mut nh).unwrap();
                 s.elapsed().as_secs_f64()
             };
             let (a, b) = if r % 2 == 0 {

@@ -8,13 +8,15 @@ use raytrail_core::method::{Bvh2Method, KdMethod, Method, StreamMethod, WideMeth
 use raytrail_core::Error;
 
 /// The methods `auto` chooses among, one per family that was the fastest somewhere in
-/// BENCHMARKS.md: the 8-wide tree (most secondary rays, every dragon ray), the kd stack traversal
-/// (primary rays in architectural scenes), the BVH2 stack method (some coherent shadow rays) and
-/// the ray-stream method (coherent primary rays inside rooms). The others each trail one of these
+/// BENCHMARKS.md: the 8-wide tree (most secondary rays, every dragon ray), the same tree walked by
+/// packets (camera rays inside rooms, shadow rays to one light through deep geometry), the kd
+/// stack traversal (primary rays in architectural scenes), the BVH2 stack method (some coherent
+/// shadow rays) and the ray-stream method (coherent primary rays inside rooms). The others each trail one of these
 /// by more than they could gain (bvh4 trails bvh8, kd-short-stack and kd-packet trail or tie
 /// kd-stack, the stackless BVH2 methods tie or trail stack on this CPU).
-pub const CANDIDATES: [Method; 4] = [
+pub const CANDIDATES: [Method; 5] = [
     Method::Wide(WideMethod::Bvh8),
+    Method::Wide(WideMethod::Bvh8Packet),
     Method::Kd(KdMethod::Stack),
     Method::Bvh2(Bvh2Method::Stack),
     Method::Stream(StreamMethod::Frustum8),

@@ -27,7 +27,7 @@ pub(crate) fn available() -> bool {
 /// [`order_by_rank`] where three or more children are hit. Private to this
 /// module and used only inside [`trace_batch`], whose caller has checked for AVX2: that is what
 /// makes its unchecked AVX calls sound (a check per node cost 2% of a ray's time).
-struct AvxKernel;
+pub(crate) struct AvxKernel;
 
 impl ChildKernel for AvxKernel {
     const BLOCKS: bool = true;

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Rays per parallel task: large enough to amortize scheduling, small enough to balance load; the
-/// packet grouping's chunk, so that kd packets never span two tasks.
+/// packet grouping's chunk, so that packets never span two tasks.
 const CHUNK: usize = PACKET_CHUNK;
 
 /// The rayon backend. Uses rayon's global pool unless built with a thread count.

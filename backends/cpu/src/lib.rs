@@ -10,6 +10,8 @@
 
 #[cfg(target_arch = "x86_64")]
 mod avx;
+#[cfg(target_arch = "x86_64")]
+mod avx_packet;
 mod backend;
 mod bvh2;
 mod chunk;

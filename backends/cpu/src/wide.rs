@@ -1,7 +1,8 @@
 //! The wide-BVH methods' loop for one chunk, monomorphized per width x memory x triangle test x
 //! recording, with the fast child kernel (SIMD box tests, the sorting network), in the AVX2 loop
-//! where the processor has AVX2. The memory prefetches hit children where that pays (a large tree,
-//! incoherent closest-hit rays: [`worth_prefetching`]).
+//! where the processor has AVX2; the packet method's loop over the chunk's packets likewise. The
+//! memory prefetches hit children where that pays (a large tree, incoherent closest-hit rays:
+//! [`worth_prefetching`]; the packet loop does not prefetch).
 
 use crate::chunk::Chunk;
 use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
@@ -10,11 +11,13 @@ use raytrail_core::method::{Method, WideMethod};
 use raytrail_core::observe::{Both, Counters, NoObserver, Observer, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
+use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{worth_prefetching, FastKernel, PrefetchingMemory, WideMemory, WideSliceMemory, WideTree};
 use raytrail_core::{Error, Hit, Ray};
 
-/// Traces one chunk with `method`; returns its counters.
+/// Traces one chunk with `method`, one ray at a time or, for a packet method, in wide packets;
+/// returns its counters. The chunk must not split the packet grouping's chunks.
 pub(crate) fn trace_chunk(
     scene: &PreparedScene,
     method: WideMethod,
@@ -58,6 +61,9 @@ impl WideRun<'_> {
         mem: &M,
         chunk: Chunk<'_>,
     ) -> Result<Counters, Error> {
+        if self.method.packets() {
+            return self.run_packets::<W, M, T>(mem, chunk);
+        }
         let (root, query) = (self.root, self.opts.query);
         let mut counters = Counters::default();
         match self.opts.record {
@@ -77,6 +83,58 @@ impl WideRun<'_> {
         counters.rays = chunk.rays.len() as u64;
         Ok(counters)
     }
+
+    /// [`WideRun::run`] in wide packets.
+    fn run_packets<const W: usize, M: WideMemory<W>, T: TriangleTest>(
+        &self,
+        mem: &M,
+        chunk: Chunk<'_>,
+    ) -> Result<Counters, Error> {
+        let (root, query) = (self.root, self.opts.query);
+        let mut counters = Counters::default();
+        match self.opts.record {
+            Record::Nothing => packets::<W, M, T, NoObserver>(mem, root, chunk.rays, chunk.hits, query, |_, _| {}),
+            Record::Counters => {
+                packets::<W, M, T, Counters>(mem, root, chunk.rays, chunk.hits, query, |_, c| counters.add(&c))
+            }
+            Record::Enumerations => {
+                let mut failed = None;
+                let slots = &mut *chunk.enumerations;
+                packets::<W, M, T, Both<Counters, Recorder>>(mem, root, chunk.rays, chunk.hits, query, |i, o| {
+                    counters.add(&o.0);
+                    match self.scene.canonical_ids(Method::Wide(self.method), o.1.nodes.iter().copied()) {
+                        Ok(ids) => slots[i] = ids,
+                        Err(e) => failed = Some(e),
+                    }
+                });
+                if let Some(e) = failed {
+                    return Err(e);
+                }
+            }
+        }
+        counters.rays = chunk.rays.len() as u64;
+        Ok(counters)
+    }
+}
+
+/// The packet loop: the AVX2 one where the processor has AVX2, else the reference packet kernel
+/// with the baseline fast child kernel.
+#[inline(always)]
+fn packets<const W: usize, M: WideMemory<W>, T: TriangleTest, O: Observer + Default>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    done: impl FnMut(usize, O),
+) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::avx::available() {
+        // SAFETY: the processor has AVX2 (checked just above).
+        unsafe { crate::avx_packet::trace_batch::<W, M, T, O>(mem, root, rays, hits, query, done) };
+        return;
+    }
+    trace_wide_packets::<W, M, T, FastKernel, ReferencePacketKernel, O>(mem, root, rays, hits, query, done);
 }
 
 /// The batch loop: the AVX2 one where the processor has AVX2, else the baseline fast kernel (SSE

@@ -49,6 +49,7 @@ const ENTRY: Part = part!(ENTRY);
 const DISPATCH_GRID: Part = part!(DISPATCH_GRID);
 const DISPATCH_PERSISTENT: Part = part!(DISPATCH_PERSISTENT);
 const WIDE: Part = part!(WIDE);
+const WIDE_PACKET: Part = part!(WIDE_PACKET);
 
 /// Everything that selects a kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -114,7 +115,11 @@ impl Variant {
         if let Method::Stream(_) = self.method {
             return Ok(parts);
         }
-        // The packet kernel defines its own work items (one packet each).
+        // The wide packet kernel has its own entry point (a packet to a workgroup).
+        if self.method.wide().is_some_and(|m| m.packets()) {
+            return Ok(parts);
+        }
+        // The kd packet kernel defines its own work items (one packet each).
         if self.method != Method::Kd(KdMethod::Packet) {
             parts.push(ENTRY);
         }
@@ -147,6 +152,7 @@ impl Variant {
                 &[KD_COMMON, KD_RESTART]
             }
             Method::Kd(KdMethod::Packet) => &[KD_COMMON, KD_PACKET],
+            Method::Wide(m) if m.packets() => &[WIDE, WIDE_PACKET],
             Method::Wide(_) => &[WIDE],
             // Its stages are kernels of their own (crate::stream); this is the one that traces.
             Method::Stream(_) => return crate::stream::compose::StreamKernel::Intersect(*self).parts(),
@@ -218,14 +224,19 @@ pub(crate) fn constants_header(method: Method) -> String {
          const KD_MODE: u32 = {kd_mode}u;\n\
          const SHORT_STACK_MAX: u32 = {SHORT_STACK_MAX}u;\n\
          const PACKET_WIDTH: u32 = {PACKET_WIDTH}u;\n\
+         const WIDE_PACKET: u32 = {wide_packet}u;\n\
          // Children per wide node.\n\
          const WIDE_W: u32 = {wide_width}u;\n",
         FAR_PAD.to_bits(),
         SLACK_SCALE.to_bits(),
         RELIABLE_LIMIT.to_bits(),
         REFINE_SCALE.to_bits(),
+        wide_packet = raytrail_core::wide::packet::WIDE_PACKET,
     )
 }
+
+// The packet kernel's ray masks are one `u32`.
+const _: () = assert!(raytrail_core::wide::packet::WIDE_PACKET <= 32, "wide packets of more than 32 rays");
 
 /// Every variant a scene with keys of width `keys` can ask for, with the default workgroup size
 /// and both dispatch files.

@@ -1,23 +1,25 @@
 //! What a trace of one method binds and sets: the scene's buffers for the method, the per-scene
-//! parameters, and the kd-packet kernel's arrangement of rays into packets.
+//! parameters, and the packet kernels' arrangement of rays into packets.
 
 use crate::batch::Launch;
 use crate::compose::Variant;
-use crate::config::GpuConfig;
+use crate::config::{Dispatch, GpuConfig};
 use crate::params::Params;
 use crate::record;
 use crate::scene::WgpuScene;
 use crate::workspace::SceneBindings;
 use raytrail_core::bvh2::NodeRef;
-use raytrail_core::kd::traverse::packets::{packet_slots, PADDING};
+use raytrail_core::kd::traverse::packets::{packet_slots_of, PADDING};
 use raytrail_core::kd::traverse::PACKET_WIDTH;
 use raytrail_core::method::{KdMethod, Method};
 use raytrail_core::trace::{Record, TraceOptions};
+use raytrail_core::wide::packet::WIDE_PACKET;
 use raytrail_core::wide::WideChild;
 use raytrail_core::{Error, Ray};
 
 /// The kernel variant for `options` on `scene` under `config`.
 pub(crate) fn variant(scene: &WgpuScene, options: &TraceOptions, config: &GpuConfig) -> Variant {
+    let config = &for_method(options.method, *config);
     Variant {
         method: options.method,
         keys: scene.prepared.key_width(),
@@ -27,6 +29,21 @@ pub(crate) fn variant(scene: &WgpuScene, options: &TraceOptions, config: &GpuCon
         dispatch: config.dispatch.into(),
         workgroup_size: config.workgroup_size,
     }
+}
+
+/// `config` as `method` runs under it: the wide packet kernel is a packet to a workgroup, so its
+/// work items are packets handed out one workgroup each (`grid` counts workgroups as items per
+/// workgroup size), on the grid.
+fn for_method(method: Method, config: GpuConfig) -> GpuConfig {
+    if is_wide_packet(method) {
+        GpuConfig { workgroup_size: 1, dispatch: Dispatch::Grid, ..config }
+    } else {
+        config
+    }
+}
+
+fn is_wide_packet(method: Method) -> bool {
+    method.wide().is_some_and(|m| m.packets())
 }
 
 /// Record words per ray for `options` with room for `cap` node events.
@@ -99,25 +116,32 @@ pub(crate) fn launch<'a>(
         }
         other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
     };
-    let rays_per_item = if options.method == Method::Kd(KdMethod::Packet) { PACKET_WIDTH } else { 1 };
+    let rays_per_item = match options.method {
+        Method::Kd(KdMethod::Packet) => PACKET_WIDTH,
+        m if is_wide_packet(m) => WIDE_PACKET,
+        _ => 1,
+    };
+    let config = for_method(options.method, config);
     Ok(Launch { pipeline, bind_layout, method: options.method, scene: scene_bindings, params, rays_per_item, config })
 }
 
-/// The kd-packet kernel's rays, grouped as the core groups them (every backend alike): slot `s`
-/// holds ray `order[s]`, padding as untraceable rays, so that packet `p` is slots
-/// `PACKET_WIDTH * p ..`.
+/// A packet kernel's rays, grouped as the core groups them (every backend alike): slot `s` holds
+/// ray `order[s]`, padding as untraceable rays, so that packet `p` is slots `width * p ..`
+/// (`PACKET_WIDTH` for kd-packet, `WIDE_PACKET` for bvh8-packet).
 pub(crate) struct Arranged {
     pub order: Vec<u32>,
     pub rays: Vec<Ray>,
 }
 
 impl Arranged {
-    /// The arrangement of `rays` for `method`; `None` for every method but kd-packet.
+    /// The arrangement of `rays` for `method`; `None` for every method but the packet ones.
     pub fn of(method: Method, rays: &[Ray]) -> Option<Arranged> {
-        if method != Method::Kd(KdMethod::Packet) {
-            return None;
-        }
-        let order = packet_slots(rays);
+        let width = match method {
+            Method::Kd(KdMethod::Packet) => PACKET_WIDTH,
+            m if is_wide_packet(m) => WIDE_PACKET,
+            _ => return None,
+        };
+        let order = packet_slots_of(rays, width);
         let pad = Ray { origin: [f32::NAN; 3], tmin: 0.0, dir: [f32::NAN; 3], tmax: 0.0 };
         let arranged = order.iter().map(|&i| if i == PADDING { pad } else { rays[i as usize] }).collect();
         Some(Arranged { order, rays: arranged })

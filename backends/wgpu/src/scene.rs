@@ -215,7 +215,7 @@ impl WgpuScene {
     pub(crate) fn wide_for(&self, method: WideMethod) -> Option<&KdBuffer> {
         match method {
             WideMethod::Bvh4 => self.wide4.as_ref(),
-            WideMethod::Bvh8 => self.wide8.as_ref(),
+            WideMethod::Bvh8 | WideMethod::Bvh8Packet => self.wide8.as_ref(),
             WideMethod::Bvh4Naive => self.wide4_naive.as_ref(),
             WideMethod::Bvh8Sah => self.wide8_sah.as_ref(),
         }

@@ -18,6 +18,11 @@ pub enum WideMethod {
     /// fewer nodes per closest-hit ray than the pull-up, more per shadow ray (BENCHMARKS.md,
     /// "The SAH-optimal 8-wide collapse").
     Bvh8Sah,
+    /// [`WideMethod::Bvh8`]'s tree walked by packets of rays of one octant
+    /// ([`crate::wide::packet`]): one node fetch, child order and stack per packet, each ray's own
+    /// box tests and answer. Beyond Guthe's paper; for coherent rays (camera rays, shadow rays to
+    /// one light).
+    Bvh8Packet,
 }
 
 /// How a wide tree is collapsed from the binary one.
@@ -34,7 +39,8 @@ pub enum Collapse {
 
 impl WideMethod {
     /// Every wide method.
-    pub const ALL: [WideMethod; 4] = [WideMethod::Bvh4, WideMethod::Bvh8, WideMethod::Bvh4Naive, WideMethod::Bvh8Sah];
+    pub const ALL: [WideMethod; 5] =
+        [WideMethod::Bvh4, WideMethod::Bvh8, WideMethod::Bvh4Naive, WideMethod::Bvh8Sah, WideMethod::Bvh8Packet];
 
     /// Command-line name.
     pub fn name(self) -> &'static str {
@@ -43,6 +49,7 @@ impl WideMethod {
             WideMethod::Bvh8 => "bvh8",
             WideMethod::Bvh4Naive => "bvh4-naive",
             WideMethod::Bvh8Sah => "bvh8-sah",
+            WideMethod::Bvh8Packet => "bvh8-packet",
         }
     }
 
@@ -50,23 +57,36 @@ impl WideMethod {
     pub fn width(self) -> usize {
         match self {
             WideMethod::Bvh4 | WideMethod::Bvh4Naive => 4,
-            WideMethod::Bvh8 | WideMethod::Bvh8Sah => 8,
+            WideMethod::Bvh8 | WideMethod::Bvh8Sah | WideMethod::Bvh8Packet => 8,
         }
     }
 
     /// How the method's tree is collapsed.
     pub fn collapse(self) -> Collapse {
         match self {
-            WideMethod::Bvh4 | WideMethod::Bvh8 => Collapse::PullUp,
+            WideMethod::Bvh4 | WideMethod::Bvh8 | WideMethod::Bvh8Packet => Collapse::PullUp,
             WideMethod::Bvh8Sah => Collapse::Optimal,
             WideMethod::Bvh4Naive => Collapse::EverySecondLevel,
         }
     }
 
+    /// Whether rays are traced in packets ([`crate::wide::packet`]) rather than one at a time.
+    pub fn packets(self) -> bool {
+        self == WideMethod::Bvh8Packet
+    }
+
     /// Per-ray state in bytes for a wide tree of `depth` levels: node address, current entry
-    /// distance, stack pointer, and `width - 1` entries of (node, entry distance) per level.
+    /// distance, stack pointer, and `width - 1` entries of (node, entry distance) per level. A
+    /// packet's node, mask and stack (entries of node, ray mask and key) are shared by its
+    /// [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET) rays; each ray adds its box interval.
     pub fn state_bytes(self, depth: u32) -> usize {
-        4 + 4 + 4 + 8 * (self.width() - 1) * depth as usize
+        if self.packets() {
+            let rays = crate::wide::packet::WIDE_PACKET;
+            let shared = 8 + 8 + 4 + 16 * (self.width() - 1) * depth as usize;
+            8 + shared.div_ceil(rays)
+        } else {
+            4 + 4 + 4 + 8 * (self.width() - 1) * depth as usize
+        }
     }
 }
 

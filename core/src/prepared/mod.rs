@@ -80,7 +80,7 @@ pub struct PreparedScene {
     pub kd: Option<PreparedKd>,
     /// The 4-wide tree by Guthe's pull-up ([`WideMethod::Bvh4`]).
     pub wide4: Option<WideBvh<4>>,
-    /// The 8-wide tree by the pull-up ([`WideMethod::Bvh8`]).
+    /// The 8-wide tree by the pull-up ([`WideMethod::Bvh8`], [`WideMethod::Bvh8Packet`]).
     pub wide8: Option<WideBvh<8>>,
     /// The 4-wide tree with every second level removed ([`WideMethod::Bvh4Naive`]).
     pub wide4_naive: Option<WideBvh<4>>,
@@ -156,7 +156,9 @@ impl PreparedScene {
         let wants = |w: WideMethod| methods.contains(&Method::Wide(w));
         let (wide4, wide8, wide4_naive, wide8_sah) = (
             wants(WideMethod::Bvh4).then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4.collapse())).transpose()?,
-            wants(WideMethod::Bvh8).then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse())).transpose()?,
+            (wants(WideMethod::Bvh8) || wants(WideMethod::Bvh8Packet))
+                .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse()))
+                .transpose()?,
             wants(WideMethod::Bvh4Naive)
                 .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4Naive.collapse()))
                 .transpose()?,
@@ -268,7 +270,7 @@ impl PreparedScene {
         Ok(match method {
             WideMethod::Bvh4 => WideTree::Four(self.wide4.as_ref().ok_or_else(missing)?),
             WideMethod::Bvh4Naive => WideTree::Four(self.wide4_naive.as_ref().ok_or_else(missing)?),
-            WideMethod::Bvh8 => WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?),
+            WideMethod::Bvh8 | WideMethod::Bvh8Packet => WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?),
             WideMethod::Bvh8Sah => WideTree::Eight(self.wide8_sah.as_ref().ok_or_else(missing)?),
         })
     }

@@ -8,6 +8,7 @@
 //! (docs/ARCHITECTURE.md, "Traversal: a state machine plus an observer").
 
 mod begin;
+pub mod packets;
 mod query;
 
 pub use crate::method::Query;

@@ -8,7 +8,9 @@
 //!   the [`FastKernel`] (SIMD box tests, the sorting network of [`network`]) that must equal it;
 //! - [`WideMemory`]: what a traversal reads, in plain slices or with the hit children
 //!   prefetched ([`PrefetchingMemory`], for trees larger than the caches);
-//! - [`traverse`]: the state machine.
+//! - [`traverse`]: the state machine;
+//! - [`packet`]: the same tree walked by packets of rays of one octant (one order and one stack
+//!   per packet, each ray's own box tests, answers and events).
 
 mod kernel;
 mod memory;
@@ -16,6 +18,7 @@ pub mod network;
 mod node;
 #[cfg(feature = "alloc")]
 mod optimal;
+pub mod packet;
 mod prefetch;
 pub mod traverse;
 #[cfg(feature = "alloc")]

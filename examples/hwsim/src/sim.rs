@@ -229,9 +229,9 @@ pub struct MethodRun {
 
 /// Simulates `method` over `rays` in lockstep warps, with the watertight triangle test: any BVH2
 /// method (with the key width the tree needs), the kd methods but the packet one, and every wide
-/// method. kd-packet is a lockstep unit of its own (four rays sharing a node) and is an
-/// [`Error::Unsupported`], as is a method `prepared` lacks the tables of
-/// ([`Error::NotPrepared`]).
+/// method but the packet one. kd-packet and bvh8-packet are lockstep units of their own (rays
+/// sharing a node) and are an [`Error::Unsupported`], as is a method `prepared` lacks the tables
+/// of ([`Error::NotPrepared`]).
 pub fn simulate(
     prepared: &PreparedScene,
     method: impl Into<Method>,
@@ -242,7 +242,7 @@ pub fn simulate(
     let mut run = match method {
         Method::Bvh2(m) => simulate_bvh2(prepared, m, rays, cfg)?,
         Method::Kd(m) => simulate_kd(prepared, m, rays, cfg)?,
-        Method::Wide(m) => simulate_wide(prepared, m, rays, cfg)?,
+        Method::Wide(m) if !m.packets() => simulate_wide(prepared, m, rays, cfg)?,
         _ => return Err(Error::Unsupported { method: method.name(), by: "the lockstep simulator" }),
     };
     run.report.method = method;

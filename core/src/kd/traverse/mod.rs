@@ -9,7 +9,7 @@
 
 mod leaf;
 mod packet;
-pub mod packets;
+pub use crate::traverse::packets;
 mod restart;
 mod run;
 mod split;

@@ -1,14 +1,16 @@
-//! How rays are grouped into kd packets: one convention for every backend, so that a ray shares
-//! its packet with the same rays everywhere and per-ray counters agree (a packet's internal nodes,
-//! pops and restarts depend on its rays; its leaves do not).
+//! How rays are grouped into packets: one convention for every backend and every packet method
+//! (kd packets of [`PACKET_WIDTH`](crate::kd::traverse::PACKET_WIDTH) rays, wide packets of
+//! [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET)), so that a ray shares its packet with the
+//! same rays everywhere and per-ray counters and enumerations agree (a packet's nodes depend on
+//! its rays).
 //!
 //! A batch is cut into chunks of [`PACKET_CHUNK`] rays; in each, rays are stably grouped by
 //! direction octant ([`octant`]) in octant order, and each octant's run is cut into packets of at
-//! most [`PACKET_WIDTH`] rays. Packets never span two chunks, so a backend may trace chunks in
+//! most the packet width. Packets never span two chunks, so a backend may trace chunks in
 //! parallel.
 
 #[cfg(feature = "alloc")]
-use super::PACKET_WIDTH;
+use crate::kd::traverse::PACKET_WIDTH;
 use crate::Ray;
 #[cfg(feature = "alloc")]
 use alloc::vec::Vec;
@@ -28,27 +30,54 @@ pub fn octant(ray: &Ray) -> usize {
         | (ray.dir[2].is_sign_negative() as usize) << 2
 }
 
-/// The packets of a batch as slots: for each slot, the index of the ray it holds or [`PADDING`].
-/// Slot `PACKET_WIDTH * p + k` is ray `k` of packet `p`; every packet but its rays is padding, and
-/// padding only ends a packet.
+/// Calls `packet` with the rays of each packet of one chunk (at most [`PACKET_CHUNK`] rays; the
+/// rest is ignored), as indices into `chunk`, in packet order: each octant's rays in chunk order,
+/// cut into runs of at most `width` (at least 1). Needs no allocation: a counting sort by octant.
+pub fn for_each_packet(chunk: &[Ray], width: usize, mut packet: impl FnMut(&[u16])) {
+    let chunk = &chunk[..chunk.len().min(PACKET_CHUNK)];
+    let mut start = [0usize; 9];
+    for r in chunk {
+        start[octant(r) + 1] += 1;
+    }
+    for o in 0..8 {
+        start[o + 1] += start[o];
+    }
+    let mut order = [0u16; PACKET_CHUNK];
+    let mut at = start;
+    for (i, r) in chunk.iter().enumerate() {
+        let o = octant(r);
+        order[at[o]] = i as u16;
+        at[o] += 1;
+    }
+    for o in 0..8 {
+        for p in order[start[o]..start[o + 1]].chunks(width.max(1)) {
+            packet(p);
+        }
+    }
+}
+
+/// The packets of a batch as slots, `width` per packet: for each slot, the index of the ray it
+/// holds or [`PADDING`]. Slot `width * p + k` is ray `k` of packet `p`; padding only ends a packet.
 #[cfg(feature = "alloc")]
-pub fn packet_slots(rays: &[Ray]) -> Vec<u32> {
-    let mut out = Vec::with_capacity(rays.len() + rays.len().div_ceil(PACKET_CHUNK) * 8 * (PACKET_WIDTH - 1));
-    let mut groups: [Vec<u32>; 8] = Default::default();
+pub fn packet_slots_of(rays: &[Ray], width: usize) -> Vec<u32> {
+    let width = width.max(1);
+    let mut out = Vec::with_capacity(rays.len() + rays.len().div_ceil(PACKET_CHUNK) * 8 * (width - 1));
     for (c, chunk) in rays.chunks(PACKET_CHUNK).enumerate() {
-        for (i, r) in chunk.iter().enumerate() {
-            groups[octant(r)].push((c * PACKET_CHUNK + i) as u32);
-        }
-        for g in &mut groups {
-            let pad = g.len().next_multiple_of(PACKET_WIDTH) - g.len();
-            out.append(g);
-            out.extend(core::iter::repeat_n(PADDING, pad));
-        }
+        for_each_packet(chunk, width, |p| {
+            out.extend(p.iter().map(|&i| (c * PACKET_CHUNK) as u32 + u32::from(i)));
+            out.extend(core::iter::repeat_n(PADDING, width - p.len()));
+        });
     }
     out
 }
 
-/// The packets of a batch as lists of ray indices (the slots of [`packet_slots`] without padding).
+/// The kd packets of a batch as slots ([`packet_slots_of`] with [`PACKET_WIDTH`]).
+#[cfg(feature = "alloc")]
+pub fn packet_slots(rays: &[Ray]) -> Vec<u32> {
+    packet_slots_of(rays, PACKET_WIDTH)
+}
+
+/// The kd packets of a batch as lists of ray indices (the slots of [`packet_slots`] without padding).
 #[cfg(feature = "alloc")]
 pub fn packets(rays: &[Ray]) -> Vec<Vec<u32>> {
     packet_slots(rays).chunks(PACKET_WIDTH).map(|p| p.iter().copied().filter(|&i| i != PADDING).collect()).collect()
@@ -108,6 +137,28 @@ mod tests {
             assert!(!real.is_empty(), "a packet of padding only");
             assert!(p[real.len()..].iter().all(|&i| i == PADDING), "padding before a ray: {p:?}");
             assert!(real.iter().all(|&i| octant(&rays[i as usize]) == octant(&rays[real[0] as usize])));
+        }
+    }
+
+    /// Any width: the stable octant sort cut into runs of at most `width`, padded to `width`.
+    #[test]
+    fn every_width_groups_as_the_octant_sort_does() {
+        let rays = mixed();
+        for width in [1, 3, 32] {
+            let slots = packet_slots_of(&rays, width);
+            assert_eq!(slots.len() % width, 0);
+            let mut want = Vec::new();
+            for (c, chunk) in rays.chunks(PACKET_CHUNK).enumerate() {
+                let mut order: Vec<u32> = (0..chunk.len() as u32).collect();
+                order.sort_by_key(|&i| octant(&chunk[i as usize]));
+                for run in order.chunk_by(|&a, &b| octant(&chunk[a as usize]) == octant(&chunk[b as usize])) {
+                    for p in run.chunks(width) {
+                        want.extend(p.iter().map(|&i| (c * PACKET_CHUNK) as u32 + i));
+                        want.extend(core::iter::repeat_n(PADDING, width - p.len()));
+                    }
+                }
+            }
+            assert_eq!(slots, want, "width {width}");
         }
     }
 

@@ -1,0 +1,272 @@
+//! The AVX2 box tests of a wide packet ([`raytrail_core::wide::packet`]): eight rays to a
+//! register, one child at a time, each lane the single-ray AVX test's operations in its order.
+//! Before that, the node's children are culled for the whole packet at once by an interval test
+//! over the packet's ranges of origins and reciprocal directions: rounding is monotonic, so the
+//! interval's ends bound every ray's computed distances and the cull never drops a child that a
+//! ray's own test would keep. It only removes work: the answers are [`ReferencePacketKernel`]'s.
+//!
+//! [`ReferencePacketKernel`]: raytrail_core::wide::packet::ReferencePacketKernel
+
+use crate::avx::AvxKernel;
+use raytrail_core::intersect::{TriangleTest, FAR_PAD};
+use raytrail_core::method::Query;
+use raytrail_core::observe::Observer;
+use raytrail_core::wide::packet::{trace_wide_packets, PacketHits, PacketKernel, PacketRays, ReferencePacketKernel};
+use raytrail_core::wide::traverse::WideRoot;
+use raytrail_core::wide::{WideMemory, WideNode, EMPTY_CHILD};
+use raytrail_core::{Hit, Ray};
+use std::arch::x86_64::{
+    __m256, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps256_ps128,
+    _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_extractf128_ps, _mm256_loadu_ps, _mm256_max_ps,
+    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setr_epi32,
+    _mm256_sub_ps, _mm_cvtss_f32, _mm_min_ps, _mm_min_ss, _mm_movehl_ps, _mm_shuffle_ps, _CMP_GT_OQ, _CMP_LE_OQ,
+};
+
+/// The packet kernel of [`trace_batch`]; private to it, whose caller has checked for AVX2 (what
+/// makes its unchecked AVX calls sound).
+struct AvxPacketKernel;
+
+impl PacketKernel for AvxPacketKernel {
+    #[inline(always)]
+    fn test<const W: usize, const N: usize>(node: &WideNode<W>, rays: &PacketRays<N>, mask: u64) -> PacketHits<W> {
+        if W == 8 && N % 8 == 0 {
+            // SAFETY: only `trace_batch` uses this kernel, and only on a processor with AVX2.
+            unsafe { test_avx(node, rays, mask) }
+        } else {
+            ReferencePacketKernel::test(node, rays, mask)
+        }
+    }
+
+    #[inline(always)]
+    fn reaching<const N: usize>(key: f32, rays: &PacketRays<N>, mask: u64) -> u64 {
+        if N % 8 == 0 {
+            // SAFETY: as `test`.
+            unsafe { reaching_avx(key, rays, mask) }
+        } else {
+            ReferencePacketKernel::reaching(key, rays, mask)
+        }
+    }
+}
+
+/// # Safety
+/// The processor must support AVX2; `N` must be a multiple of 8.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn reaching_avx<const N: usize>(key: f32, p: &PacketRays<N>, mask: u64) -> u64 {
+    let k = _mm256_set1_ps(key);
+    let mut out = 0u64;
+    for g in 0..N / 8 {
+        let t_hi = _mm256_loadu_ps(p.t_hi.as_ptr().add(8 * g));
+        out |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(k, t_hi)) as u64) << (8 * g);
+    }
+    out & mask
+}
+
+/// # Safety
+/// The processor must support AVX2; `W` must be 8 and `N` a multiple of 8.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &PacketRays<N>, mask: u64) -> PacketHits<W> {
+    let mut out = PacketHits { key: [f32::INFINITY; W], rays: [0; W] };
+    let mut todo = cull(node, p);
+    // Bit k of a lane's own constant: the lanes of a register group picked by 8 bits of `mask`.
+    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    let pad = _mm256_set1_ps(FAR_PAD);
+    let ld = |a: &[f32; N], at: usize| _mm256_loadu_ps(a.as_ptr().add(at));
+    while todo != 0 {
+        let c = todo.trailing_zeros() as usize;
+        todo &= todo - 1;
+        let mut key = _mm256_set1_ps(f32::INFINITY);
+        let mut rays = 0u64;
+        for g in 0..N / 8 {
+            let group = ((mask >> (8 * g)) & 0xff) as i32;
+            if group == 0 {
+                continue;
+            }
+            let at = 8 * g;
+            let (mut t_enter, mut t_exit) = (ld(&p.t_lo, at), ld(&p.t_hi, at));
+            for a in 0..3 {
+                let (lo, hi) = (_mm256_set1_ps(node.lo[a][c % W]), _mm256_set1_ps(node.hi[a][c % W]));
+                let (o, inv) = (ld(&p.origin[a], at), ld(&p.inv_dir[a], at));
+                let (near, far) = (_mm256_blendv_ps(lo, hi, inv), _mm256_blendv_ps(hi, lo, inv));
+                let tn = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
+                let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), pad);
+                t_enter = _mm256_max_ps(tn, t_enter);
+                t_exit = _mm256_min_ps(tf, t_exit);
+            }
+            let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, _mm256_add_ps(t_exit, ld(&p.slack, at)));
+            let in_mask =
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(group), bits), bits));
+            let hit = _mm256_and_ps(hit, in_mask);
+            rays |= (_mm256_movemask_ps(hit) as u64) << at;
+            key = _mm256_min_ps(_mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t_enter, hit), key);
+        }
+        if rays != 0 {
+            out.rays[c % W] = rays;
+            out.key[c % W] = horizontal_min(key);
+        }
+    }
+    out
+}
+
+/// The least lane of `v`.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn horizontal_min(v: __m256) -> f32 {
+    let h = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
+    let h = _mm_min_ps(h, _mm_movehl_ps(h, h));
+    _mm_cvtss_f32(_mm_min_ss(h, _mm_shuffle_ps::<1>(h, h)))
+}
+
+/// The children some ray of the packet may hit (a bit per slot): the others are culled by the
+/// interval test, all eight at once. Packets whose reciprocal directions differ in sign on an axis
+/// or are not finite keep every non-empty child.
+///
+/// # Safety
+/// As [`test_avx`].
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn cull<const W: usize, const N: usize>(node: &WideNode<W>, p: &PacketRays<N>) -> u32 {
+    let present = (0..W).fold(0u32, |m, s| m | u32::from(node.child[s] != EMPTY_CHILD) << s);
+    let one_sign = p.inv_range.iter().all(|&(l, h)| (l > 0.0 && h.is_finite()) || (h < 0.0 && l.is_finite()));
+    if !one_sign {
+        return present;
+    }
+    let s = _mm256_set1_ps;
+    let (mut t_enter, mut t_exit) = (s(p.t_lo_min), s(p.t_hi_max));
+    for a in 0..3 {
+        let (lo, hi) = (_mm256_loadu_ps(node.lo[a].as_ptr()), _mm256_loadu_ps(node.hi[a].as_ptr()));
+        let (near, far) = if p.inv_range[a].0 < 0.0 { (hi, lo) } else { (lo, hi) };
+        let ((o0, o1), (i0, i1)) = (p.origin_range[a], p.inv_range[a]);
+        let (o0, o1, i0, i1) = (s(o0), s(o1), s(i0), s(i1));
+        // Each ray's rounded `(plane - o) * inv` lies between the least and the greatest of the
+        // four corner products (the product is monotonic in each factor, and so is rounding).
+        let corners = |x0: __m256, x1: __m256| {
+            [_mm256_mul_ps(x0, i0), _mm256_mul_ps(x0, i1), _mm256_mul_ps(x1, i0), _mm256_mul_ps(x1, i1)]
+        };
+        let n = corners(_mm256_sub_ps(near, o1), _mm256_sub_ps(near, o0));
+        let f = corners(_mm256_sub_ps(far, o1), _mm256_sub_ps(far, o0));
+        let tn = _mm256_min_ps(_mm256_min_ps(n[0], n[1]), _mm256_min_ps(n[2], n[3]));
+        let tf = _mm256_max_ps(_mm256_max_ps(f[0], f[1]), _mm256_max_ps(f[2], f[3]));
+        t_enter = _mm256_max_ps(t_enter, tn);
+        // The padding multiply raises a positive exit and lowers a negative one: keep the larger.
+        t_exit = _mm256_min_ps(t_exit, _mm256_max_ps(_mm256_mul_ps(tf, s(FAR_PAD)), tf));
+    }
+    let missed = _mm256_cmp_ps::<_CMP_GT_OQ>(t_enter, _mm256_add_ps(t_exit, s(p.slack_max)));
+    present & !(_mm256_movemask_ps(missed) as u32)
+}
+
+/// [`trace_wide_packets`] with the AVX2 child kernel and packet kernel, compiled for AVX2.
+///
+/// # Safety
+/// The processor must support AVX2 ([`crate::avx::available`]).
+#[target_feature(enable = "avx2")]
+pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer + Default>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    done: impl FnMut(usize, O),
+) {
+    trace_wide_packets::<W, M, T, AvxKernel, AvxPacketKernel, O>(mem, root, rays, hits, query, done);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use raytrail_core::intersect::{NoPair, Watertight};
+    use raytrail_core::traverse::begin;
+    use raytrail_core::wide::WideChild;
+
+    /// xorshift64.
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+
+        /// Mostly ordinary values in [-4, 4], with zeros of both signs and exact repeats.
+        fn value(&mut self) -> f32 {
+            match self.next() % 12 {
+                0 => 0.0,
+                1 => -0.0,
+                2 => 1.0,
+                _ => ((self.next() >> 8) % 4001) as f32 / 500.0 - 4.0,
+            }
+        }
+    }
+
+    /// Packets of 32 rays, half of them of one octant (where the interval cull applies), against
+    /// nodes of random boxes with empty slots: every mask and key the reference's, and the rays
+    /// reaching a key alike.
+    #[test]
+    fn avx_packet_kernel_matches_the_reference() {
+        if !crate::avx::available() {
+            eprintln!("SKIPPED the AVX2 packet kernel test: this processor has no AVX2");
+            return;
+        }
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let (mut culled_packets, mut hits) = (0, 0);
+        for round in 0..4000 {
+            let one_octant = round % 2 == 0;
+            let signs = [rng.next() % 2 == 0, rng.next() % 2 == 0, rng.next() % 2 == 0];
+            let mut p = PacketRays::<32>::EMPTY;
+            let mut mask = 0u64;
+            for i in 0..32 {
+                let mut dir = [rng.value(), rng.value(), rng.value()];
+                if one_octant {
+                    for a in 0..3 {
+                        dir[a] = if signs[a] { -(dir[a].abs() + 0.25) } else { dir[a].abs() + 0.25 };
+                    }
+                }
+                let spread = if one_octant { 0.05 } else { 1.0 };
+                let ray = Ray {
+                    origin: [rng.value() * spread, rng.value() * spread, rng.value() * spread],
+                    tmin: [0.0, 0.5][(rng.next() % 2) as usize],
+                    dir,
+                    tmax: [f32::INFINITY, 3.0][(rng.next() % 2) as usize],
+                };
+                let Some((ctx, q)) = begin::<Watertight, NoPair>(&ray, 8.0, Query::Closest) else { continue };
+                p.set_lane(i, &ctx, &q);
+                if rng.next() % 4 != 0 {
+                    mask |= 1 << i;
+                }
+            }
+            let mut node = WideNode::<8>::EMPTY;
+            for s in 0..8 {
+                if rng.next() % 5 == 0 {
+                    continue;
+                }
+                let (a, b) = (
+                    Vec3::new(rng.value(), rng.value(), rng.value()),
+                    Vec3::new(rng.value(), rng.value(), rng.value()),
+                );
+                node.set_child(s, a.min(b), a.max(b), WideChild::Node(s as u32));
+            }
+            // SAFETY: AVX2 checked above.
+            let got = unsafe { test_avx(&node, &p, mask) };
+            let want = ReferencePacketKernel::test(&node, &p, mask);
+            assert_eq!(got.rays, want.rays, "round {round}");
+            assert_eq!(got.key, want.key, "round {round}");
+            hits += want.rays.iter().filter(|&&r| r != 0).count();
+            // SAFETY: as above.
+            if unsafe { cull(&node, &p) } != (0..8).fold(0, |m, s| m | u32::from(node.child[s] != EMPTY_CHILD) << s) {
+                culled_packets += 1;
+            }
+            for key in [f32::NEG_INFINITY, -1.0, 0.0, 0.5, 2.0, 3.0, f32::INFINITY] {
+                assert_eq!(
+                    AvxPacketKernel::reaching(key, &p, mask),
+                    ReferencePacketKernel::reaching(key, &p, mask),
+                    "round {round}, key {key}"
+                );
+            }
+        }
+        assert!(hits > 2_000 && culled_packets > 200, "{hits} child hits, {culled_packets} packets culled");
+    }
+}

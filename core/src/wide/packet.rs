@@ -1,0 +1,353 @@
+//! Packets of rays through a wide BVH: up to 64 rays of one direction octant share one walk of
+//! the tree, one node fetch, one child order and one stack per packet. Each ray keeps its own
+//! box decisions, its own answer and its own events; the packet only decides the order.
+//!
+//! The rule (what a reference traversal, every fast path and every backend must follow):
+//! - A packet visits a child with the mask of its rays whose own box test (the single-ray test,
+//!   over the ray's own interval at that moment) hits the child; every such ray records the visit.
+//! - Hit children are ordered by their key, the least entry distance over the packet's rays that
+//!   hit them, nearest first with ties to the smaller slot, for closest-hit queries; in slot order
+//!   for any-hit queries (Guthe's unsorted occlusion). The first is visited next, the others are
+//!   pushed with their masks and keys.
+//! - At a leaf, every ray of the mask tests its triangles as the single-ray method does; an
+//!   any-hit ray that finds one leaves the packet.
+//! - A popped entry keeps the rays of its mask still in the packet, each recording a stack pop,
+//!   and of those the rays whose box interval still reaches the key (a ray's own entry distance
+//!   is no less than the key, so a ray dropped here would have dropped the child alone too).
+//!
+//! Closest hits are the single-ray method's bit for bit: every ray still tests every leaf whose
+//! box it enters before its closest hit, and ties go to the smaller primitive id whatever the
+//! order. Any-hit answers agree on occlusion (which occluder is found first may differ).
+//!
+//! The box tests of a node are a [`PacketKernel`]: the plain [`ReferencePacketKernel`], one ray
+//! and one child at a time, or a backend's vector test that equals it.
+
+use super::kernel::{ChildHits, ChildKernel, ReferenceKernel};
+use super::memory::WideMemory;
+use super::node::{WideChild, WideNode};
+use super::traverse::{leaf, WideRayContext, WideRoot, WIDE_STACK};
+use crate::intersect::{NoPair, SlabRay, TriangleTest};
+use crate::method::Query;
+use crate::observe::{Backtrack, Observer};
+use crate::traverse::packets::{for_each_packet, PACKET_CHUNK};
+use crate::traverse::{begin, QueryState};
+use crate::{Hit, Ray};
+use core::mem::MaybeUninit;
+
+/// Rays per wide packet: four registers of eight lanes on AVX2, and where packets measured best
+/// against single rays on coherent rays (the prototype's 8 to 64 rays: BENCHMARKS.md, "Single-ray
+/// changes that did not pay, and packets that might").
+pub const WIDE_PACKET: usize = 32;
+
+/// The rays of a packet as the box tests read them: per ray (lane), the slab constants and the
+/// interval a box is tested over, with bounds over the packet that a vector test may cull by.
+#[derive(Clone, Copy, Debug)]
+pub struct PacketRays<const N: usize> {
+    /// Origins, by axis.
+    pub origin: [[f32; N]; 3],
+    /// Reciprocal directions, by axis.
+    pub inv_dir: [[f32; N]; 3],
+    /// Box interval start (`tmin - slack`; `+inf` for a lane without a ray).
+    pub t_lo: [f32; N],
+    /// Box interval end (`limit + slack`, following the ray's closest hit; `-inf` without a ray).
+    pub t_hi: [f32; N],
+    /// The slab test's slack.
+    pub slack: [f32; N],
+    /// Per axis, the least and greatest origin over the packet's rays.
+    pub origin_range: [(f32, f32); 3],
+    /// Per axis, the least and greatest reciprocal direction over the packet's rays.
+    pub inv_range: [(f32, f32); 3],
+    /// The least `t_lo` over the packet's rays.
+    pub t_lo_min: f32,
+    /// The greatest slack over the packet's rays.
+    pub slack_max: f32,
+    /// The greatest `t_hi` over the packet's rays still in it.
+    pub t_hi_max: f32,
+}
+
+/// The box tests of one node for a packet: per child slot, the rays that hit it and its key.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PacketHits<const W: usize> {
+    /// The least entry distance over the rays that hit each child (`+inf` where none does).
+    pub key: [f32; W],
+    /// The rays (bits of the packet) that hit each child.
+    pub rays: [u64; W],
+}
+
+/// Tests a node's children for the rays of a packet.
+pub trait PacketKernel {
+    /// For each child slot of `node`, the rays of `mask` whose single-ray slab test
+    /// ([`SlabRay::hit_scalar`] over `[t_lo, t_hi]` with the ray's slack) hits it, and the least
+    /// of their entry distances.
+    fn test<const W: usize, const N: usize>(node: &WideNode<W>, rays: &PacketRays<N>, mask: u64) -> PacketHits<W>;
+
+    /// The rays of `mask` whose box interval still reaches `key` (`key <= t_hi`).
+    #[inline(always)]
+    fn reaching<const N: usize>(key: f32, rays: &PacketRays<N>, mask: u64) -> u64 {
+        let mut out = 0;
+        for_each_ray(mask, |i| out |= u64::from(key <= rays.t_hi[i]) << i);
+        out
+    }
+}
+
+/// One ray and one child at a time, through [`ReferenceKernel`]: what every fast path must equal.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ReferencePacketKernel;
+
+impl PacketKernel for ReferencePacketKernel {
+    fn test<const W: usize, const N: usize>(node: &WideNode<W>, rays: &PacketRays<N>, mask: u64) -> PacketHits<W> {
+        let mut out = PacketHits { key: [f32::INFINITY; W], rays: [0; W] };
+        let mut m = mask;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let h = ReferenceKernel::test(node, &rays.slab(i), rays.t_lo[i], rays.t_hi[i]);
+            for s in 0..W {
+                if h.mask & (1 << s) != 0 {
+                    out.rays[s] |= 1 << i;
+                    if h.t_enter[s] < out.key[s] {
+                        out.key[s] = h.t_enter[s];
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+impl<const N: usize> PacketRays<N> {
+    /// A packet without rays.
+    pub const EMPTY: PacketRays<N> = PacketRays {
+        origin: [[0.0; N]; 3],
+        inv_dir: [[0.0; N]; 3],
+        t_lo: [f32::INFINITY; N],
+        t_hi: [f32::NEG_INFINITY; N],
+        slack: [0.0; N],
+        origin_range: [(f32::INFINITY, f32::NEG_INFINITY); 3],
+        inv_range: [(f32::INFINITY, f32::NEG_INFINITY); 3],
+        t_lo_min: f32::INFINITY,
+        slack_max: 0.0,
+        t_hi_max: f32::NEG_INFINITY,
+    };
+
+    /// Puts the ray of `ctx`, whose answer so far is `q`, in lane `i` (below `N`), widening the
+    /// packet's bounds to it.
+    pub fn set_lane<T: TriangleTest>(&mut self, i: usize, ctx: &WideRayContext<T>, q: &QueryState) {
+        for a in 0..3 {
+            (self.origin[a][i], self.inv_dir[a][i]) = (ctx.slab.origin[a], ctx.slab.inv_dir[a]);
+            let (o, inv) = (&mut self.origin_range[a], &mut self.inv_range[a]);
+            *o = (o.0.min(ctx.slab.origin[a]), o.1.max(ctx.slab.origin[a]));
+            *inv = (inv.0.min(ctx.slab.inv_dir[a]), inv.1.max(ctx.slab.inv_dir[a]));
+        }
+        (self.t_lo[i], self.t_hi[i]) = ctx.box_interval(q.limit());
+        self.slack[i] = ctx.slab.slack;
+        self.t_lo_min = self.t_lo_min.min(self.t_lo[i]);
+        self.slack_max = self.slack_max.max(self.slack[i]);
+        self.t_hi_max = self.t_hi_max.max(self.t_hi[i]);
+    }
+
+    /// Lane `i`'s slab constants (the signs of `1 / d` are `d`'s).
+    pub fn slab(&self, i: usize) -> SlabRay {
+        let inv = glam::Vec3A::new(self.inv_dir[0][i], self.inv_dir[1][i], self.inv_dir[2][i]);
+        SlabRay {
+            origin: glam::Vec3A::new(self.origin[0][i], self.origin[1][i], self.origin[2][i]),
+            inv_dir: inv,
+            negative: [inv.x.is_sign_negative(), inv.y.is_sign_negative(), inv.z.is_sign_negative()],
+            slack: self.slack[i],
+        }
+    }
+}
+
+/// A postponed child with the rays that hit it and its key.
+#[derive(Clone, Copy)]
+struct Entry {
+    child: WideChild,
+    rays: u64,
+    key: f32,
+}
+
+/// Traces one packet: `rays` (at most `N`, at most 64; the rest is ignored) over a `W`-wide tree,
+/// the children tested by `P` and ordered and the leaves tested by `K`, per the rule in the
+/// module docs. Answers go to `hits`, each ray's events to its own observer in `obs`.
+pub fn trace_wide_packet<
+    const W: usize,
+    const N: usize,
+    M: WideMemory<W> + ?Sized,
+    T: TriangleTest,
+    K: ChildKernel,
+    P: PacketKernel,
+    O: Observer,
+>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    query: Query,
+    hits: &mut [Hit],
+    obs: &mut [O],
+) {
+    let n = rays.len().min(N).min(64).min(hits.len()).min(obs.len());
+    let mut ctx: [Option<(WideRayContext<T>, QueryState)>; N] = core::array::from_fn(|_| None);
+    let mut p = PacketRays::<N>::EMPTY;
+    let mut active = 0u64;
+    for i in 0..n {
+        hits[i] = Hit::MISS;
+        let Some((c, q)) = begin::<T, NoPair>(&rays[i], root.scene_scale, query) else { continue };
+        p.set_lane(i, &c, &q);
+        ctx[i] = Some((c, q));
+        active |= 1 << i;
+    }
+    let mut stack: [MaybeUninit<Entry>; WIDE_STACK] = [const { MaybeUninit::uninit() }; WIDE_STACK];
+    let mut len = 0usize;
+    let mut current = (active != 0).then_some((root.root, active));
+    let mut budget = root.max_steps;
+    while let Some((child, mask)) = current {
+        if O::ENABLED {
+            for_each_ray(mask, |i| obs[i].node(child.node_ref()));
+        }
+        let next = match child {
+            WideChild::Node(index) => {
+                let node = mem.wide_node(index);
+                let h = P::test::<W, N>(&node, &p, mask);
+                let hit_slots = (0..W).fold(0u32, |m, s| m | u32::from(h.rays[s] != 0) << s);
+                let mut order = [0u32; W];
+                let count = if hit_slots == 0 {
+                    0
+                } else if query.is_any() && !K::SORTED_ANY {
+                    let mut m = hit_slots;
+                    let mut k = 0;
+                    while m != 0 {
+                        order[k] = m.trailing_zeros();
+                        m &= m - 1;
+                        k += 1;
+                    }
+                    k
+                } else {
+                    K::order::<W>(&ChildHits { t_enter: h.key, mask: hit_slots }, &mut order)
+                };
+                for k in (1..count).rev() {
+                    let slot = order[k] as usize % W;
+                    if let (Some(c), true) = (node.child_ref(slot), len < WIDE_STACK) {
+                        stack[len] = MaybeUninit::new(Entry { child: c, rays: h.rays[slot], key: h.key[slot] });
+                        len += 1;
+                    }
+                }
+                let first = order[0] as usize % W;
+                match node.child_ref(first).filter(|_| count > 0) {
+                    Some(c) => Some((c, h.rays[first])),
+                    None => pop::<N, P, O>(&stack, &mut len, &p, active, obs),
+                }
+            }
+            WideChild::Leaf { first, count } => {
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let Some((c, q)) = ctx[i].as_mut() else { continue };
+                    leaf::<W, M, T, K, O>(mem, first, count, c, q, &mut obs[i]);
+                    if q.is_answered() {
+                        active &= !(1 << i);
+                    } else {
+                        p.t_hi[i] = c.box_interval(q.limit()).1;
+                    }
+                }
+                // Lanes without a ray hold `-inf`, and closest-hit rays never leave the packet; an
+                // any-hit ray's interval never shrinks, so the bound stays one (if looser) as its
+                // rays leave.
+                if !query.is_any() {
+                    p.t_hi_max = p.t_hi.iter().fold(f32::NEG_INFINITY, |m, &t| m.max(t));
+                }
+                pop::<N, P, O>(&stack, &mut len, &p, active, obs)
+            }
+        };
+        current = match next {
+            Some(c) if budget > 0 && active != 0 => {
+                budget -= 1;
+                Some(c)
+            }
+            _ => None,
+        };
+    }
+    for i in 0..n {
+        if let Some((_, q)) = &ctx[i] {
+            hits[i] = q.hit;
+        }
+    }
+}
+
+/// Calls `f` with each ray of `mask`, in order.
+#[inline(always)]
+fn for_each_ray(mut mask: u64, mut f: impl FnMut(usize)) {
+    while mask != 0 {
+        f(mask.trailing_zeros() as usize);
+        mask &= mask - 1;
+    }
+}
+
+/// The next postponed child with rays still looking for it (see the module docs), or `None`.
+#[inline(always)]
+fn pop<const N: usize, P: PacketKernel, O: Observer>(
+    stack: &[MaybeUninit<Entry>; WIDE_STACK],
+    len: &mut usize,
+    p: &PacketRays<N>,
+    active: u64,
+    obs: &mut [O],
+) -> Option<(WideChild, u64)> {
+    while *len > 0 {
+        *len -= 1;
+        // SAFETY: entries below `len` were written by a push before `len` passed them.
+        let e = unsafe { stack[*len].assume_init() };
+        let rays = e.rays & active;
+        if O::ENABLED {
+            for_each_ray(rays, |i| obs[i].backtrack(0, Backtrack::StackPop));
+        }
+        let live = P::reaching(e.key, p, rays);
+        if live != 0 {
+            return Some((e.child, live));
+        }
+    }
+    None
+}
+
+/// Traces `rays` into `hits` in the packets of the grouping ([`for_each_packet`] with
+/// [`WIDE_PACKET`] rays, over chunks of [`PACKET_CHUNK`] from the start of `rays`), handing each
+/// ray's index and observer to `done` once its packet is traced.
+pub fn trace_wide_packets<
+    const W: usize,
+    M: WideMemory<W> + ?Sized,
+    T: TriangleTest,
+    K: ChildKernel,
+    P: PacketKernel,
+    O: Observer + Default,
+>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    mut done: impl FnMut(usize, O),
+) {
+    let n = rays.len().min(hits.len());
+    for (c, chunk) in rays[..n].chunks(PACKET_CHUNK).enumerate() {
+        let base = c * PACKET_CHUNK;
+        for_each_packet(chunk, WIDE_PACKET, |idx| {
+            let mut packet = [Ray { origin: [0.0; 3], tmin: 0.0, dir: [0.0; 3], tmax: 0.0 }; WIDE_PACKET];
+            for (k, &i) in idx.iter().enumerate() {
+                packet[k] = chunk[i as usize];
+            }
+            let mut out = [Hit::MISS; WIDE_PACKET];
+            let mut obs: [O; WIDE_PACKET] = core::array::from_fn(|_| O::default());
+            trace_wide_packet::<W, WIDE_PACKET, M, T, K, P, O>(
+                mem,
+                root,
+                &packet[..idx.len()],
+                query,
+                &mut out,
+                &mut obs,
+            );
+            for ((k, &i), o) in idx.iter().enumerate().zip(obs) {
+                hits[base + i as usize] = out[k];
+                done(base + i as usize, o);
+            }
+        });
+    }
+}

@@ -1,0 +1,242 @@
+// Method bvh8-packet: bvh8's tree walked by packets of WIDE_PACKET rays of one direction octant
+// (`wide::packet`), a packet to a workgroup and a ray to an invocation. The host arranges the batch
+// into the core's packets (padding as untraceable rays), so workgroup p traces slots
+// `WIDE_PACKET * p ..`. The rule is the core's, step for step:
+// - every ray of the current mask records the visit and, at a node, tests the children with the
+//   single-ray box test over its own interval; per child, the rays that hit it gather into a mask
+//   and their least entry distance into its key (workgroup atomics);
+// - one invocation orders the hit children as `wide.wgsl` does (the network for closest hits, slot
+//   order for any hit), visits the first and pushes the others with their masks and keys;
+// - at a leaf, every ray of the mask tests its triangles; an any-hit ray that finds one leaves;
+// - a popped entry keeps its rays still in the packet (each records a stack pop) whose interval
+//   reaches the key, checked by the rays themselves in a step of their own.
+// Each step is one turn of a loop that the whole workgroup runs together (its exit is read with
+// `workgroupUniformLoad`), so the barriers stay in uniform control flow. Built on `wide.wgsl`
+// (WT_T, WT_SLOT, wide_test, wide_sort, wide_slot, wide_leaf, wide_ref).
+
+// The dispatch override every kernel declares; the workgroup is a packet here.
+override WORKGROUP_SIZE: u32 = 64u;
+
+const WP_STACK_SIZE: u32 = (WIDE_W - 1u) * 64u;
+// `wp_ordered(+inf)`: the key of a child no ray hits.
+const WP_KEY_NONE: u32 = 0xff800000u;
+// What the current step does: visit WP_CUR, or check which rays of a popped entry reach it.
+const WP_VISIT: u32 = 1u;
+const WP_CHECK: u32 = 2u;
+
+// A child with its rays and key (the current one, or a postponed one).
+struct WpEntry {
+    child: u32,
+    count: u32,
+    rays: u32,
+    key: f32,
+}
+
+var<workgroup> WP_STACK: array<WpEntry, WP_STACK_SIZE>;
+var<workgroup> WP_LEN: u32;
+var<workgroup> WP_CUR: WpEntry;
+var<workgroup> WP_PHASE: u32;
+var<workgroup> WP_GO: u32;
+var<workgroup> WP_BUDGET: u32;
+var<workgroup> WP_ACTIVE: atomic<u32>;
+var<workgroup> WP_LIVE: atomic<u32>;
+var<workgroup> WP_HITS: array<atomic<u32>, WIDE_W>;
+var<workgroup> WP_KEYS: array<atomic<u32>, WIDE_W>;
+// Each ray's box interval end (`limit + slack`), kept by the ray.
+var<workgroup> WP_T_HI: array<f32, WIDE_PACKET>;
+// The leading invocation's copy of the rays per hit slot.
+var<private> WP_RAYS: array<u32, WIDE_W>;
+
+// Float bits as an unsigned integer in the floats' order, for `atomicMin`.
+fn wp_ordered(t: f32) -> u32 {
+    let b = bitcast<u32>(t);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
+fn wp_unordered(k: u32) -> f32 {
+    return bitcast<f32>(select(~k, k & 0x7fffffffu, (k & 0x80000000u) != 0u));
+}
+
+// One ray's part of a step.
+fn wp_lane(lane: u32) {
+    let cur = WP_CUR;
+    let bit = 1u << lane;
+    if (cur.rays & bit) == 0u {
+        return;
+    }
+    if WP_PHASE == WP_CHECK {
+        rec_backtrack(0u, VIA_STACK_POP);
+        if cur.key <= WP_T_HI[lane] {
+            atomicOr(&WP_LIVE, bit);
+        }
+        return;
+    }
+    rec_node(wide_ref(WideChild(cur.child, cur.count)));
+    if cur.count != 0u {
+        wide_leaf(cur.child, cur.count);
+        if q_is_answered() {
+            atomicAnd(&WP_ACTIVE, ~bit);
+        } else {
+            WP_T_HI[lane] = box_interval(q_limit()).y;
+        }
+        return;
+    }
+    let iv = box_interval(q_limit());
+    let mask = wide_test(cur.child, iv.x, iv.y);
+    for (var i = 0u; i < WIDE_W; i = i + 1u) {
+        if (mask & (1u << i)) != 0u {
+            atomicOr(&WP_HITS[i], bit);
+            atomicMin(&WP_KEYS[i], wp_ordered(WT_T[i]));
+        }
+    }
+}
+
+// Visits `c` with `rays` next, within the step budget.
+fn wp_enter(c: WideChild, rays: u32, key: f32) {
+    if WP_BUDGET == 0u || atomicLoad(&WP_ACTIVE) == 0u {
+        WP_GO = 0u;
+        return;
+    }
+    WP_BUDGET = WP_BUDGET - 1u;
+    WP_CUR = WpEntry(c.child, c.count, rays, key);
+    WP_PHASE = WP_VISIT;
+}
+
+// The next postponed entry with rays still in the packet, to be checked; none ends the packet.
+fn wp_pop() {
+    let in_packet = atomicLoad(&WP_ACTIVE);
+    loop {
+        if WP_LEN == 0u || in_packet == 0u {
+            WP_GO = 0u;
+            return;
+        }
+        WP_LEN = WP_LEN - 1u;
+        let e = WP_STACK[WP_LEN];
+        let rays = e.rays & in_packet;
+        if rays != 0u {
+            WP_CUR = WpEntry(e.child, e.count, rays, e.key);
+            WP_PHASE = WP_CHECK;
+            return;
+        }
+    }
+}
+
+// The leading invocation's part of a step: what comes next.
+fn wp_lead() {
+    let cur = WP_CUR;
+    if WP_PHASE == WP_CHECK {
+        let live = atomicLoad(&WP_LIVE);
+        atomicStore(&WP_LIVE, 0u);
+        if live != 0u {
+            wp_enter(WideChild(cur.child, cur.count), live, cur.key);
+        } else {
+            wp_pop();
+        }
+        return;
+    }
+    if cur.count != 0u {
+        wp_pop();
+        return;
+    }
+    // `sort_keys` over the packet's keys, as `wide_test` leaves them for one ray.
+    var mask = 0u;
+    for (var i = 0u; i < WIDE_W; i = i + 1u) {
+        let rays = atomicLoad(&WP_HITS[i]);
+        let key = wp_unordered(atomicLoad(&WP_KEYS[i]));
+        atomicStore(&WP_HITS[i], 0u);
+        atomicStore(&WP_KEYS[i], WP_KEY_NONE);
+        WP_RAYS[i] = rays;
+        WT_T[i] = select(bitcast<f32>(0x7f800000u), key, rays != 0u);
+        WT_SLOT[i] = select(i + WIDE_W, i, rays != 0u);
+        if rays != 0u {
+            mask = mask | (1u << i);
+        }
+    }
+    if mask == 0u {
+        wp_pop();
+        return;
+    }
+    // As `wide_step`: all hit children but the first pushed, farthest first.
+    var first_slot = countTrailingZeros(mask);
+    if !ANY_HIT {
+        wide_sort();
+        first_slot = WT_SLOT[0] % WIDE_W;
+    }
+    let n = countOneBits(mask);
+    for (var j = 1u; j < WIDE_W; j = j + 1u) {
+        let k = WIDE_W - j;
+        var slot = k;
+        var push = (mask & (1u << k)) != 0u && k != first_slot;
+        if !ANY_HIT {
+            slot = WT_SLOT[k] % WIDE_W;
+            push = k < n;
+        }
+        if push && WP_LEN < WP_STACK_SIZE {
+            let s = wide_slot(cur.child, slot);
+            if s.ok {
+                WP_STACK[WP_LEN] = WpEntry(s.c.child, s.c.count, WP_RAYS[slot], WT_T[k]);
+                WP_LEN = WP_LEN + 1u;
+            }
+        }
+    }
+    let first = wide_slot(cur.child, first_slot);
+    if first.ok {
+        wp_enter(first.c, WP_RAYS[first_slot], WT_T[0]);
+    } else {
+        wp_pop();
+    }
+}
+
+@compute @workgroup_size(WIDE_PACKET)
+fn main(
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let slot = (wid.x + wid.y * groups.x) * WIDE_PACKET + lane;
+    let have = slot < P.ray_count;
+    var mine = false;
+    if have {
+        rec_begin(slot);
+        mine = begin(rays[slot]);
+    }
+    if lane < WIDE_W {
+        atomicStore(&WP_HITS[lane], 0u);
+        atomicStore(&WP_KEYS[lane], WP_KEY_NONE);
+    }
+    if lane == 0u {
+        atomicStore(&WP_ACTIVE, 0u);
+        atomicStore(&WP_LIVE, 0u);
+        WP_LEN = 0u;
+        WP_BUDGET = P.max_steps;
+        WP_PHASE = WP_VISIT;
+    }
+    WP_T_HI[lane] = select(bitcast<f32>(0xff800000u), box_interval(q_limit()).y, mine);
+    workgroupBarrier();
+    if mine {
+        atomicOr(&WP_ACTIVE, 1u << lane);
+    }
+    workgroupBarrier();
+    if lane == 0u {
+        let in_packet = atomicLoad(&WP_ACTIVE);
+        if P.wide_root_count != 0u {
+            WP_CUR = WpEntry(leaf_offset(P.root), P.wide_root_count, in_packet, 0.0);
+        } else {
+            WP_CUR = WpEntry(P.root, 0u, in_packet, 0.0);
+        }
+        WP_GO = select(0u, 1u, in_packet != 0u);
+    }
+    loop {
+        if workgroupUniformLoad(&WP_GO) == 0u {
+            break;
+        }
+        wp_lane(lane);
+        workgroupBarrier();
+        if lane == 0u {
+            wp_lead();
+        }
+    }
+    if have {
+        hits[slot] = Q_HIT;
+    }
+}
