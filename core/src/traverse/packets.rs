@@ -33,6 +33,8 @@ pub fn octant(ray: &Ray) -> usize {
 /// Calls `packet` with the rays of each packet of one chunk (at most [`PACKET_CHUNK`] rays; the
 /// rest is ignored), as indices into `chunk`, in packet order: each octant's rays in chunk order,
 /// cut into runs of at most `width` (at least 1). Needs no allocation: a counting sort by octant.
+/// Inlined, so that `packet` compiles as its caller does (for a vector extension, say).
+#[inline(always)]
 pub fn for_each_packet(chunk: &[Ray], width: usize, mut packet: impl FnMut(&[u16])) {
     let chunk = &chunk[..chunk.len().min(PACKET_CHUNK)];
     let mut start = [0usize; 9];

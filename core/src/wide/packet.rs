@@ -132,6 +132,7 @@ impl<const N: usize> PacketRays<N> {
 
     /// Puts the ray of `ctx`, whose answer so far is `q`, in lane `i` (below `N`), widening the
     /// packet's bounds to it.
+    #[inline(always)]
     pub fn set_lane<T: TriangleTest>(&mut self, i: usize, ctx: &WideRayContext<T>, q: &QueryState) {
         for a in 0..3 {
             (self.origin[a][i], self.inv_dir[a][i]) = (ctx.slab.origin[a], ctx.slab.inv_dir[a]);
@@ -169,6 +170,9 @@ struct Entry {
 /// Traces one packet: `rays` (at most `N`, at most 64; the rest is ignored) over a `W`-wide tree,
 /// the children tested by `P` and ordered and the leaves tested by `K`, per the rule in the
 /// module docs. Answers go to `hits`, each ray's events to its own observer in `obs`.
+///
+/// Inlined, so that a backend's caller compiled for a vector extension compiles all of it so.
+#[inline(always)]
 pub fn trace_wide_packet<
     const W: usize,
     const N: usize,
@@ -311,6 +315,7 @@ fn pop<const N: usize, P: PacketKernel, O: Observer>(
 /// Traces `rays` into `hits` in the packets of the grouping ([`for_each_packet`] with
 /// [`WIDE_PACKET`] rays, over chunks of [`PACKET_CHUNK`] from the start of `rays`), handing each
 /// ray's index and observer to `done` once its packet is traced.
+#[inline(always)]
 pub fn trace_wide_packets<
     const W: usize,
     M: WideMemory<W> + ?Sized,
