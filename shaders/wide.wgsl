@@ -166,6 +166,22 @@ fn wide_pop() -> u32 {
     return STEP_DONE;
 }
 
+// Push `k` of a node's expansion, k = WIDE_W - 1 down to 1 (`WideState::step`'s pushes): for a
+// closest-hit query the child of rank k, pushed if hit (a miss sorts after every hit, so rank
+// k < n is a hit); for an any-hit query slot k, pushed if hit and not the first. `n` hit
+// children, `first_slot` visited next; WT_SLOT sorted by `wide_sort` for closest hits.
+struct WidePush {
+    push: bool,
+    slot: u32,
+}
+
+fn wide_push(k: u32, mask: u32, first_slot: u32, n: u32) -> WidePush {
+    if ANY_HIT {
+        return WidePush((mask & (1u << k)) != 0u && k != first_slot, k);
+    }
+    return WidePush(k < n, WT_SLOT[k] % WIDE_W);
+}
+
 // `WideState::step`.
 fn wide_step() -> u32 {
     if !WS_HAS_CURRENT {
@@ -197,13 +213,9 @@ fn wide_step() -> u32 {
     let n = countOneBits(mask);
     for (var j = 1u; j < WIDE_W; j = j + 1u) {
         let k = WIDE_W - j;
-        var slot = k;
-        var push = (mask & (1u << k)) != 0u && k != first_slot;
-        if !ANY_HIT {
-            slot = WT_SLOT[k] % WIDE_W;
-            push = k < n;
-        }
-        if push && WS_LEN < WIDE_STACK {
+        let p = wide_push(k, mask, first_slot, n);
+        let slot = p.slot;
+        if p.push && WS_LEN < WIDE_STACK {
             let s = wide_slot(cur.child, slot);
             if s.ok {
                 WS_STACK[WS_LEN] = WideEntry(s.c.child, s.c.count, WT_T[k]);

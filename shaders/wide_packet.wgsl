@@ -165,13 +165,9 @@ fn wp_lead() {
     let n = countOneBits(mask);
     for (var j = 1u; j < WIDE_W; j = j + 1u) {
         let k = WIDE_W - j;
-        var slot = k;
-        var push = (mask & (1u << k)) != 0u && k != first_slot;
-        if !ANY_HIT {
-            slot = WT_SLOT[k] % WIDE_W;
-            push = k < n;
-        }
-        if push && WP_LEN < WP_STACK_SIZE {
+        let p = wide_push(k, mask, first_slot, n);
+        let slot = p.slot;
+        if p.push && WP_LEN < WP_STACK_SIZE {
             let s = wide_slot(cur.child, slot);
             if s.ok {
                 WP_STACK[WP_LEN] = WpEntry(s.c.child, s.c.count, WP_RAYS[slot], WT_T[k]);

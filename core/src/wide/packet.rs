@@ -25,7 +25,7 @@
 use super::kernel::{ChildHits, ChildKernel, ReferenceKernel};
 use super::memory::WideMemory;
 use super::node::{WideChild, WideNode};
-use super::traverse::{leaf, WideRayContext, WideRoot, WIDE_STACK};
+use super::traverse::{leaf, visiting_order, WideRayContext, WideRoot, WIDE_STACK};
 use crate::intersect::{NoPair, SlabRay, TriangleTest};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
@@ -216,17 +216,8 @@ pub fn trace_wide_packet<
                 let mut order = [0u32; W];
                 let count = if hit_slots == 0 {
                     0
-                } else if query.is_any() && !K::SORTED_ANY {
-                    let mut m = hit_slots;
-                    let mut k = 0;
-                    while m != 0 {
-                        order[k] = m.trailing_zeros();
-                        m &= m - 1;
-                        k += 1;
-                    }
-                    k
                 } else {
-                    K::order::<W>(&ChildHits { t_enter: h.key, mask: hit_slots }, &mut order)
+                    visiting_order::<W, K>(&ChildHits { t_enter: h.key, mask: hit_slots }, query.is_any(), &mut order)
                 };
                 for k in (1..count).rev() {
                     let slot = order[k] as usize % W;

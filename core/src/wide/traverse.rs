@@ -2,7 +2,7 @@
 //! tested at once, hit children nearest first for closest-hit queries and unsorted for any-hit
 //! queries (Sec. 4.2: all hit children but one are pushed, none sorted).
 
-use super::kernel::ChildKernel;
+use super::kernel::{ChildHits, ChildKernel};
 use super::memory::WideMemory;
 use super::node::WideChild;
 use crate::intersect::{BlockHits, NoPair, RayContext, TriangleHit, TriangleTest, BLOCK};
@@ -175,18 +175,7 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
         }
     }
     let mut order = [0u32; W];
-    let n = if q.any && !K::SORTED_ANY {
-        let mut m = hits.mask;
-        let mut n = 0;
-        while m != 0 {
-            order[n] = m.trailing_zeros();
-            m &= m - 1;
-            n += 1;
-        }
-        n
-    } else {
-        K::order::<W>(&hits, &mut order)
-    };
+    let n = visiting_order::<W, K>(&hits, q.any, &mut order);
     for k in (1..n).rev() {
         let slot = order[k] as usize;
         if *len < WIDE_STACK {
@@ -199,6 +188,28 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
     match node.child_ref(order[0] as usize) {
         Some(c) => Expanded::Next(c),
         None => Expanded::EmptyFirst,
+    }
+}
+
+/// Writes the hit slots of `hits` to `order` in the order they are visited and returns how many
+/// there are: nearest first (`K::order`) for closest-hit queries, slot order for any-hit ones
+/// (Guthe's unsorted occlusion) unless `K` sorts those too.
+#[inline(always)]
+pub(crate) fn visiting_order<const W: usize, K: ChildKernel>(
+    hits: &ChildHits<W>,
+    any: bool,
+    order: &mut [u32; W],
+) -> usize {
+    if any && !K::SORTED_ANY {
+        let (mut m, mut n) = (hits.mask, 0);
+        while m != 0 {
+            order[n] = m.trailing_zeros();
+            m &= m - 1;
+            n += 1;
+        }
+        n
+    } else {
+        K::order::<W>(hits, order)
     }
 }
 
