@@ -166,6 +166,17 @@ fn wide_pop() -> u32 {
     return STEP_DONE;
 }
 
+// The slot visited first among the hit children `mask` (nonzero): the nearest for a closest-hit
+// query, after sorting WT_T and WT_SLOT by the network (which `wide_push` then reads); the
+// smallest hit slot for an any-hit query.
+fn wide_order(mask: u32) -> u32 {
+    if ANY_HIT {
+        return countTrailingZeros(mask);
+    }
+    wide_sort();
+    return WT_SLOT[0] % WIDE_W;
+}
+
 // Push `k` of a node's expansion, k = WIDE_W - 1 down to 1 (`WideState::step`'s pushes): for a
 // closest-hit query the child of rank k, pushed if hit (a miss sorts after every hit, so rank
 // k < n is a hit); for an any-hit query slot k, pushed if hit and not the first. `n` hit
@@ -205,11 +216,7 @@ fn wide_step() -> u32 {
     // after the network, for an any-hit query in descending slot order (unsorted, Sec. 4.2).
     // Rank and slot run over constants; a miss sorts after every hit, so rank k < n is a hit.
     // Slot 0 is never pushed: when hit, it is the first.
-    var first_slot = countTrailingZeros(mask);
-    if !ANY_HIT {
-        wide_sort();
-        first_slot = WT_SLOT[0] % WIDE_W;
-    }
+    let first_slot = wide_order(mask);
     let n = countOneBits(mask);
     for (var j = 1u; j < WIDE_W; j = j + 1u) {
         let k = WIDE_W - j;

@@ -12,7 +12,7 @@
 //   reaches the key, checked by the rays themselves in a step of their own.
 // Each step is one turn of a loop that the whole workgroup runs together (its exit is read with
 // `workgroupUniformLoad`), so the barriers stay in uniform control flow. Built on `wide.wgsl`
-// (WT_T, WT_SLOT, wide_test, wide_sort, wide_slot, wide_leaf, wide_ref).
+// (WT_T, WT_SLOT, wide_test, wide_order, wide_push, wide_slot, wide_leaf, wide_ref).
 
 // The dispatch override every kernel declares; the workgroup is a packet here.
 override WORKGROUP_SIZE: u32 = 64u;
@@ -157,11 +157,7 @@ fn wp_lead() {
         return;
     }
     // As `wide_step`: all hit children but the first pushed, farthest first.
-    var first_slot = countTrailingZeros(mask);
-    if !ANY_HIT {
-        wide_sort();
-        first_slot = WT_SLOT[0] % WIDE_W;
-    }
+    let first_slot = wide_order(mask);
     let n = countOneBits(mask);
     for (var j = 1u; j < WIDE_W; j = j + 1u) {
         let k = WIDE_W - j;
