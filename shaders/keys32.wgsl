@@ -26,6 +26,11 @@ fn key_one() -> Key {
     return 1u;
 }
 
+// A key of value `v`.
+fn key_from_u32(v: u32) -> Key {
+    return v;
+}
+
 fn key_root() -> Key {
     return 1u;
 }

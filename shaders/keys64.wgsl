@@ -26,6 +26,11 @@ fn key_one() -> Key {
     return vec2<u32>(1u, 0u);
 }
 
+// A key of value `v`.
+fn key_from_u32(v: u32) -> Key {
+    return vec2<u32>(v, 0u);
+}
+
 fn key_root() -> Key {
     return vec2<u32>(1u, 0u);
 }

@@ -183,6 +183,12 @@ pub const WIDE: Source = Source { name: "wide.wgsl", text: include_str!("wide.wg
 /// `wide_packet.wgsl`.
 pub const WIDE_PACKET: Source = Source { name: "wide_packet.wgsl", text: include_str!("wide_packet.wgsl") };
 
+/// `wide_stack.wgsl`.
+pub const WIDE_STACK: Source = Source { name: "wide_stack.wgsl", text: include_str!("wide_stack.wgsl") };
+
+/// `wide_trail.wgsl`.
+pub const WIDE_TRAIL: Source = Source { name: "wide_trail.wgsl", text: include_str!("wide_trail.wgsl") };
+
 /// Every file, in name order.
 pub const ALL: &[Source] = &[
     BOX,
@@ -237,6 +243,8 @@ pub const ALL: &[Source] = &[
     TRIANGLE_WATERTIGHT,
     WIDE,
     WIDE_PACKET,
+    WIDE_STACK,
+    WIDE_TRAIL,
 ];
 
 /// The file of `name` (for example `"box.wgsl"`), if there is one.

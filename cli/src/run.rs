@@ -244,6 +244,18 @@ fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedScene) {
     if p.wide4.is_some() || p.wide8.is_some() || p.wide4_naive.is_some() {
         println!("  wide trees collapsed in {:.1} ms", 1e3 * p.timings.wide);
     }
+    match &p.wide4_hash {
+        Some(Ok(h)) => {
+            let (st, nodes) = (&h.hash.stats, p.wide4.as_ref().map_or(0, |t| t.stats().node_bytes));
+            println!(
+                "  hash tables (4-wide node keys, bvh4-hash): {} keys, {} keys and trails, D = {}, H = {}, {} direct, {:.2} MB = +{:.1}% of the 4-wide nodes, built in {:.1} ms",
+                st.keys, h.keys, st.d_size, st.h_size, st.direct, mb(st.bytes),
+                100.0 * st.bytes as f64 / nodes.max(1) as f64, 1e3 * p.timings.wide_hash
+            );
+        }
+        Some(Err(e)) => println!("  hash tables (4-wide node keys, bvh4-hash): none, {e}"),
+        None => {}
+    }
     if let Some(kd) = &p.kd {
         let k = kd.tree.stats();
         println!(

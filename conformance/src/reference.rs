@@ -6,13 +6,15 @@ use raytrail_core::bvh2::traverse::trace_ray;
 use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use raytrail_core::kd::traverse::packets::packets;
 use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, RestartPolicy, PACKET_WIDTH};
-use raytrail_core::key::KeyWidth;
+use raytrail_core::key::{Key, KeyWidth};
 use raytrail_core::method::{KdMethod, Method, Query, StreamMethod};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::stream::{trace_stream_with, FrustumCull, Serial};
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
+use raytrail_core::wide::keyed::WideKeyedMemory;
 use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
+use raytrail_core::wide::trail::trace_wide_trail_batch;
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{ReferenceKernel, WideSliceMemory, WideTree};
 use raytrail_core::{Error, Hit, Ray};
@@ -75,6 +77,14 @@ impl SerialBackend {
                     })
                     .collect())
             }
+            Method::Wide(m) if m.keyed() => {
+                let root = scene.wide_root(m)?;
+                let (mem, keys) = scene.wide_keyed(m)?;
+                Ok(match keys {
+                    KeyWidth::W32 => Self::keyed::<u32, _, T>(&mem, root, rays, query),
+                    KeyWidth::W64 => Self::keyed::<u64, _, T>(&mem, root, rays, query),
+                })
+            }
             Method::Wide(m) => {
                 let root = scene.wide_root(m)?;
                 match scene.wide_tree(m)? {
@@ -119,6 +129,26 @@ impl SerialBackend {
             .map(|ray| {
                 let mut o = Both(Counters::default(), Recorder::default());
                 (trace_wide_ray::<W, _, T, ReferenceKernel, _>(mem, root, ray, query, &mut o), o)
+            })
+            .collect()
+    }
+}
+
+impl SerialBackend {
+    /// The keyed, stackless wide traversal with the reference kernel, one ray at a time.
+    fn keyed<K: Key, M: WideKeyedMemory<4>, T: TriangleTest>(
+        mem: &M,
+        root: WideRoot,
+        rays: &[Ray],
+        query: Query,
+    ) -> Vec<Traced> {
+        rays.iter()
+            .map(|ray| {
+                let mut o = Both(Counters::default(), Recorder::default());
+                let mut hit = Hit::MISS;
+                let (r, h) = (std::slice::from_ref(ray), std::slice::from_mut(&mut hit));
+                trace_wide_trail_batch::<4, K, M, T, ReferenceKernel, _>(mem, root, r, h, query, &mut o);
+                (hit, o)
             })
             .collect()
     }

@@ -15,9 +15,11 @@ use crate::reference::SerialBackend;
 use crate::scenes::{generated, tiny_cases, NamedScene};
 use raytrail_core::bvh2::{Bvh2, SahBuilder};
 use raytrail_core::key::KeyWidth;
-use raytrail_core::method::{Bvh2Method, Method};
+use raytrail_core::method::{Bvh2Method, Method, WideMethod};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, Trace, TraceOptions};
+use raytrail_core::wide::keyed::wide_key_width;
+use raytrail_core::wide::WideBvh;
 use raytrail_core::{Hit, Ray};
 use std::any::Any;
 use std::fmt::Display;
@@ -73,6 +75,9 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
             let s = generated_scene("degenerate_stack");
             let bvh = sah(&s);
             assert_eq!(bvh.stats().key_width, KeyWidth::W64, "depth {} should need 64-bit keys", bvh.stats().depth);
+            let wide = WideBvh::<4>::build(&bvh, s.scene.triangles(), WideMethod::Bvh4Hash.collapse()).expect("bvh4");
+            let depth = wide.stats().depth;
+            assert_eq!(wide_key_width::<4>(depth), Some(KeyWidth::W64), "4-wide depth {depth} should need 64-bit keys");
             check_scene(backend, &s, |_| bvh.clone(), GENERATED_RAYS);
         }
         Case::FarFromOrigin => check_scene(backend, &generated_scene("far_from_origin"), sah, GENERATED_RAYS),

@@ -25,6 +25,8 @@ pub enum Error {
     TreeTooDeep {
         /// The tree's depth.
         depth: u32,
+        /// The deepest its keys allow: 63 for a binary tree, 31 for a 4-wide one.
+        max: u32,
     },
     /// Node or leaf addresses do not fit the 30 bits the node references reserve for them.
     TreeTooLarge {
@@ -89,8 +91,8 @@ impl fmt::Display for Error {
                 write!(f, "triangle {triangle} references vertex {index}, but there are only {vertex_count} vertices")
             }
             Error::NonFiniteVertex { vertex } => write!(f, "vertex {vertex} has a NaN or infinite coordinate"),
-            Error::TreeTooDeep { depth } => {
-                write!(f, "tree depth {depth} exceeds the 63 levels that 64-bit keys allow")
+            Error::TreeTooDeep { depth, max } => {
+                write!(f, "tree depth {depth} exceeds the {max} levels that 64-bit keys allow")
             }
             Error::TreeTooLarge { what, size } => {
                 write!(f, "{what} ({size}) exceeds the 2^30 addresses node references allow")

@@ -132,6 +132,7 @@ pub fn maker(part: Part) -> Method {
         Part::FullHash => Method::Bvh2(Bvh2Method::HashResume),
         Part::Kd => Method::Kd(KdMethod::Stack),
         Part::Wide4 => Method::Wide(WideMethod::Bvh4),
+        Part::Wide4Hash => Method::Wide(WideMethod::Bvh4Hash),
         Part::Wide8 => Method::Wide(WideMethod::Bvh8),
         Part::Wide4Naive => Method::Wide(WideMethod::Bvh4Naive),
         Part::Wide8Sah => Method::Wide(WideMethod::Bvh8Sah),
@@ -159,6 +160,7 @@ pub fn prepare_every_part(
             Part::FullHash => t.full_hash,
             Part::Kd => t.kd,
             Part::Wide4 | Part::Wide8 | Part::Wide4Naive | Part::Wide8Sah => t.wide,
+            Part::Wide4Hash => t.wide_hash,
             Part::Levels => t.levels,
         };
         let bytes = p.part_bytes(part).ok_or(Error::NotPrepared { method: maker(part).name(), missing: "its part" })?;
@@ -174,6 +176,7 @@ pub fn prepare_every_part(
             Part::FullHash => acc.full_hash = p.full_hash.take(),
             Part::Kd => acc.kd = p.kd.take(),
             Part::Wide4 => acc.wide4 = p.wide4.take(),
+            Part::Wide4Hash => acc.wide4_hash = p.wide4_hash.take(),
             Part::Wide8 => acc.wide8 = p.wide8.take(),
             Part::Wide4Naive => acc.wide4_naive = p.wide4_naive.take(),
             Part::Wide8Sah => acc.wide8_sah = p.wide8_sah.take(),

@@ -5,8 +5,11 @@
 //! them to that on adversarial values.
 
 use raytrail_core::intersect::{SlabRay, TriangleTest, FAR_PAD};
+use raytrail_core::key::Key;
 use raytrail_core::method::Query;
 use raytrail_core::observe::Observer;
+use raytrail_core::wide::keyed::WideKeyedMemory;
+use raytrail_core::wide::trail::trace_wide_trail_batch;
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideMemory, WideNode};
 use raytrail_core::{Hit, Ray};
@@ -145,6 +148,29 @@ pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: T
     obs: &mut O,
 ) {
     trace_wide_batch::<W, M, T, AvxKernel, O>(mem, root, rays, hits, query, obs);
+}
+
+/// [`trace_wide_trail_batch`] (the keyed, stackless traversal) with [`AvxKernel`], compiled for
+/// AVX2.
+///
+/// # Safety
+/// The processor must support AVX2 ([`available`]).
+#[target_feature(enable = "avx2")]
+pub(crate) unsafe fn trace_keyed_batch<
+    const W: usize,
+    K: Key,
+    M: WideKeyedMemory<W> + ?Sized,
+    T: TriangleTest,
+    O: Observer,
+>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    obs: &mut O,
+) {
+    trace_wide_trail_batch::<W, K, M, T, AvxKernel, O>(mem, root, rays, hits, query, obs);
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ mod backend;
 mod bvh2;
 mod chunk;
 mod kd;
+mod keyed;
 pub mod ploc;
 mod stream;
 mod wide;

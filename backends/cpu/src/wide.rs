@@ -5,6 +5,7 @@
 //! [`worth_prefetching`]; the packet loop does not prefetch).
 
 use crate::chunk::Chunk;
+use core::marker::PhantomData;
 use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use raytrail_core::method::Query;
 use raytrail_core::method::{Method, WideMethod};
@@ -24,6 +25,9 @@ pub(crate) fn trace_chunk(
     opts: &TraceOptions,
     chunk: Chunk<'_>,
 ) -> Result<Counters, Error> {
+    if method.keyed() {
+        return crate::keyed::trace_chunk(scene, method, opts, chunk);
+    }
     let root = scene.wide_root(method)?;
     match scene.wide_tree(method)? {
         WideTree::Four(t) => WideRun { scene, method, opts, root }.go(t.memory(), chunk),
@@ -64,24 +68,8 @@ impl WideRun<'_> {
         if self.method.packets() {
             return self.run_packets::<W, M, T>(mem, chunk);
         }
-        let (root, query) = (self.root, self.opts.query);
-        let mut counters = Counters::default();
-        match self.opts.record {
-            Record::Nothing => batch::<W, M, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut NoObserver),
-            Record::Counters => batch::<W, M, T, _>(mem, root, chunk.rays, chunk.hits, query, &mut counters),
-            Record::Enumerations => {
-                let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());
-                for ((ray, hit), nodes) in slots {
-                    let mut obs = Both(counters, Recorder::default());
-                    let (ray, hit) = (core::slice::from_ref(ray), core::slice::from_mut(hit));
-                    batch::<W, M, T, _>(mem, root, ray, hit, query, &mut obs);
-                    counters = obs.0;
-                    *nodes = self.scene.canonical_ids(Method::Wide(self.method), obs.1.nodes.iter().copied())?;
-                }
-            }
-        }
-        counters.rays = chunk.rays.len() as u64;
-        Ok(counters)
+        let stack = StackBatch::<W, M, T> { mem, root: self.root, query: self.opts.query, test: PhantomData };
+        record_rays(self.scene, self.method, self.opts.record, chunk, &stack)
     }
 
     /// [`WideRun::run`] in wide packets.
@@ -114,6 +102,54 @@ impl WideRun<'_> {
         }
         counters.rays = chunk.rays.len() as u64;
         Ok(counters)
+    }
+}
+
+/// One loop over a slice of rays, generic over what observes it (so one recording routine serves
+/// the stack and the keyed traversals).
+pub(crate) trait RayLoop {
+    /// Traces `rays` into `hits`, reporting to `obs`.
+    fn trace<O: Observer>(&self, rays: &[Ray], hits: &mut [Hit], obs: &mut O);
+}
+
+/// Traces a chunk ray by ray with `rays`, observing what `record` asks for: nothing, counters,
+/// or each ray's enumeration in canonical node ids.
+pub(crate) fn record_rays(
+    scene: &PreparedScene,
+    method: WideMethod,
+    record: Record,
+    chunk: Chunk<'_>,
+    rays: &impl RayLoop,
+) -> Result<Counters, Error> {
+    let mut counters = Counters::default();
+    match record {
+        Record::Nothing => rays.trace(chunk.rays, chunk.hits, &mut NoObserver),
+        Record::Counters => rays.trace(chunk.rays, chunk.hits, &mut counters),
+        Record::Enumerations => {
+            let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());
+            for ((ray, hit), nodes) in slots {
+                let mut obs = Both(counters, Recorder::default());
+                rays.trace(core::slice::from_ref(ray), core::slice::from_mut(hit), &mut obs);
+                counters = obs.0;
+                *nodes = scene.canonical_ids(Method::Wide(method), obs.1.nodes.iter().copied())?;
+            }
+        }
+    }
+    counters.rays = chunk.rays.len() as u64;
+    Ok(counters)
+}
+
+/// The stack traversal's loop ([`batch`]).
+struct StackBatch<'m, const W: usize, M, T> {
+    mem: &'m M,
+    root: WideRoot,
+    query: Query,
+    test: PhantomData<T>,
+}
+
+impl<const W: usize, M: WideMemory<W>, T: TriangleTest> RayLoop for StackBatch<'_, W, M, T> {
+    fn trace<O: Observer>(&self, rays: &[Ray], hits: &mut [Hit], obs: &mut O) {
+        batch::<W, M, T, O>(self.mem, self.root, rays, hits, self.query, obs);
     }
 }
 

@@ -50,6 +50,8 @@ const DISPATCH_GRID: Part = part!(DISPATCH_GRID);
 const DISPATCH_PERSISTENT: Part = part!(DISPATCH_PERSISTENT);
 const WIDE: Part = part!(WIDE);
 const WIDE_PACKET: Part = part!(WIDE_PACKET);
+const WIDE_STACK: Part = part!(WIDE_STACK);
+const WIDE_TRAIL: Part = part!(WIDE_TRAIL);
 
 /// Everything that selects a kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -153,7 +155,8 @@ impl Variant {
             }
             Method::Kd(KdMethod::Packet) => &[KD_COMMON, KD_PACKET],
             Method::Wide(m) if m.packets() => &[WIDE, WIDE_PACKET],
-            Method::Wide(_) => &[WIDE],
+            Method::Wide(m) if m.keyed() => &[WIDE, keys, HASH, WIDE_TRAIL],
+            Method::Wide(_) => &[WIDE, WIDE_STACK],
             // Its stages are kernels of their own (crate::stream); this is the one that traces.
             Method::Stream(_) => return crate::stream::compose::StreamKernel::Intersect(*self).parts(),
             other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
@@ -225,13 +228,15 @@ pub(crate) fn constants_header(method: Method) -> String {
          const SHORT_STACK_MAX: u32 = {SHORT_STACK_MAX}u;\n\
          const PACKET_WIDTH: u32 = {PACKET_WIDTH}u;\n\
          const WIDE_PACKET: u32 = {wide_packet}u;\n\
-         // Children per wide node.\n\
-         const WIDE_W: u32 = {wide_width}u;\n",
+         // Children per wide node, and the node keys' bits per level (its log2).\n\
+         const WIDE_W: u32 = {wide_width}u;\n\
+         const WK_BITS: u32 = {wide_bits}u;\n",
         FAR_PAD.to_bits(),
         SLACK_SCALE.to_bits(),
         RELIABLE_LIMIT.to_bits(),
         REFINE_SCALE.to_bits(),
         wide_packet = raytrail_core::wide::packet::WIDE_PACKET,
+        wide_bits = wide_width.trailing_zeros(),
     )
 }
 

@@ -11,6 +11,7 @@ use crate::workspace::SceneBindings;
 use raytrail_core::bvh2::NodeRef;
 use raytrail_core::kd::traverse::packets::{packet_slots_of, PADDING};
 use raytrail_core::kd::traverse::PACKET_WIDTH;
+use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{KdMethod, Method};
 use raytrail_core::trace::{Record, TraceOptions};
 use raytrail_core::wide::packet::WIDE_PACKET;
@@ -22,12 +23,21 @@ pub(crate) fn variant(scene: &WgpuScene, options: &TraceOptions, config: &GpuCon
     let config = &for_method(options.method, *config);
     Variant {
         method: options.method,
-        keys: scene.prepared.key_width(),
+        keys: keys_for(scene, options.method),
         triangle: options.triangle_test,
         query: options.query,
         record: options.record,
         dispatch: config.dispatch.into(),
         workgroup_size: config.workgroup_size,
+    }
+}
+
+/// The key width of `method`'s kernel: the 4-wide tree's for the keyed wide method, the binary
+/// tree's otherwise (only the BVH2 stackless methods read it there).
+fn keys_for(scene: &WgpuScene, method: Method) -> KeyWidth {
+    match method.wide() {
+        Some(m) if m.keyed() => scene.prepared.wide_keyed(m).map_or(KeyWidth::W64, |(_, keys)| keys),
+        _ => scene.prepared.key_width(),
     }
 }
 
@@ -112,7 +122,21 @@ pub(crate) fn launch<'a>(
                 WideChild::Node(n) => (n, 0),
                 WideChild::Leaf { first, count } => (NodeRef::leaf(first).0, count),
             };
-            SceneBindings { bvh: &scene.empty, hash: &scene.empty, kd: &tree.buffer }
+            let hash = match &scene.wide4_hash {
+                Some(h) if m.keyed() => {
+                    // Fails with the scene's reason where it holds no tables (a tree too deep).
+                    p.wide_keyed(m)?;
+                    params.d_mask = h.d_mask;
+                    params.h = h.h;
+                    &h.buffer
+                }
+                None if m.keyed() => {
+                    p.wide_keyed(m)?;
+                    return Err(Error::NotPrepared { method: m.name(), missing: "its key hash" });
+                }
+                _ => &scene.empty,
+            };
+            SceneBindings { bvh: &scene.empty, hash, kd: &tree.buffer }
         }
         other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
     };

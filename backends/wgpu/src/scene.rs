@@ -43,6 +43,8 @@ pub struct WgpuScene {
     pub(crate) kd: Option<KdBuffer>,
     /// The wide trees, laid out as the kd-tree is: nodes, primitive ids, triangles.
     pub(crate) wide4: Option<KdBuffer>,
+    /// The hash over the 4-wide tree's node keys (bvh4-hash).
+    pub(crate) wide4_hash: Option<HashBuffer>,
     pub(crate) wide8: Option<KdBuffer>,
     pub(crate) wide4_naive: Option<KdBuffer>,
     pub(crate) wide8_sah: Option<KdBuffer>,
@@ -144,6 +146,10 @@ impl WgpuScene {
                 })
                 .transpose()?;
         let wide4 = p.wide4.as_ref().map(|t| wide(gpu, "4-wide BVH", t)).transpose()?;
+        let wide4_hash = match &p.wide4_hash {
+            Some(Ok(h)) => Some(hash(gpu, "4-wide key hash", &h.hash)?),
+            _ => None,
+        };
         let wide8 = p.wide8.as_ref().map(|t| wide(gpu, "8-wide BVH", t)).transpose()?;
         let wide4_naive = p.wide4_naive.as_ref().map(|t| wide(gpu, "naive 4-wide BVH", t)).transpose()?;
         let wide8_sah = p.wide8_sah.as_ref().map(|t| wide(gpu, "SAH-optimal 8-wide BVH", t)).transpose()?;
@@ -169,6 +175,7 @@ impl WgpuScene {
             full_hash,
             kd,
             wide4,
+            wide4_hash,
             wide8,
             wide4_naive,
             wide8_sah,
@@ -214,7 +221,7 @@ impl WgpuScene {
     /// The wide tree buffer `method` reads.
     pub(crate) fn wide_for(&self, method: WideMethod) -> Option<&KdBuffer> {
         match method {
-            WideMethod::Bvh4 => self.wide4.as_ref(),
+            WideMethod::Bvh4 | WideMethod::Bvh4Hash => self.wide4.as_ref(),
             WideMethod::Bvh8 | WideMethod::Bvh8Packet => self.wide8.as_ref(),
             WideMethod::Bvh4Naive => self.wide4_naive.as_ref(),
             WideMethod::Bvh8Sah => self.wide8_sah.as_ref(),
@@ -232,6 +239,7 @@ impl WgpuScene {
             + h(&self.full_hash)
             + k(&self.kd)
             + k(&self.wide4)
+            + h(&self.wide4_hash)
             + k(&self.wide8)
             + k(&self.wide4_naive)
             + k(&self.wide8_sah)

@@ -1,5 +1,5 @@
 //! A stack of parallel, nearly coincident triangles that drives the binned SAH builder into a
-//! chain deeper than 31 levels, so the tree needs 64-bit keys.
+//! chain deeper than 31 levels, so the tree needs 64-bit keys (and its 4-wide tree too).
 
 use super::scene_of;
 use crate::rng::Pcg32;
@@ -11,9 +11,10 @@ use raytrail_core::scene::Scene;
 /// checks the depth this gives).
 const GROUP: usize = 4;
 
-/// Layers of the suite's stack: the SAH tree is `(layers - 8) / 4` deep (40), past the 31 levels
-/// of 32-bit keys and well inside the 63 of 64-bit ones.
-pub const DEFAULT_LAYERS: usize = 168;
+/// Layers of the suite's stack: the SAH tree is `(layers - 8) / 4` deep (52), past the 31 levels
+/// of 32-bit keys and inside the 63 of 64-bit ones; its 4-wide pull-up is 18 deep, past the 15
+/// levels of 32-bit 4-wide keys (two bits per level), so `bvh4-hash` runs on 64-bit keys too.
+pub const DEFAULT_LAYERS: usize = 216;
 
 /// Most layers: a tree of depth 63.
 pub const MAX_LAYERS: usize = 8 + GROUP * 63;

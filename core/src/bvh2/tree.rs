@@ -81,7 +81,7 @@ impl Bvh2 {
                 return Err(Error::MalformedTree("a node is reached twice"));
             }
             if depth > 63 {
-                return Err(Error::TreeTooDeep { depth });
+                return Err(Error::TreeTooDeep { depth, max: 63 });
             }
             stats.depth = stats.depth.max(depth);
             let new = out.len() as u32;
@@ -130,7 +130,7 @@ impl Bvh2 {
         if out.len() >= super::NodeRef::LIMIT as usize {
             return Err(Error::TreeTooLarge { what: "node count", size: out.len() });
         }
-        stats.key_width = KeyWidth::for_depth(stats.depth).ok_or(Error::TreeTooDeep { depth: stats.depth })?;
+        stats.key_width = KeyWidth::for_depth(stats.depth).ok_or(Error::TreeTooDeep { depth: stats.depth, max: 63 })?;
         Ok(Bvh2 { nodes: out, prim_order: new_order, stats })
     }
 

@@ -43,7 +43,19 @@ pub fn encode_direct(r: NodeRef) -> i32 {
 /// entry held the address itself (one load instead of two).
 #[inline(always)]
 pub fn lookup<K: Key, M: BvhMemory + ?Sized>(mem: &M, shape: HashShape, key: K) -> (NodeRef, bool) {
-    let d = mem.displacement(key.low_u32() & shape.d_mask);
+    lookup_in(|i| mem.displacement(i), |i| mem.hash_cell(i), shape, key)
+}
+
+/// [`lookup`] in tables read through `displacement` and `cell` (entry and cell by index), for
+/// memories other than a BVH2's (the wide trees' keyed memory).
+#[inline(always)]
+pub fn lookup_in<K: Key>(
+    displacement: impl Fn(u32) -> i32,
+    cell: impl Fn(u32) -> u32,
+    shape: HashShape,
+    key: K,
+) -> (NodeRef, bool) {
+    let d = displacement(key.low_u32() & shape.d_mask);
     if d < 0 {
         let a = d as u32;
         let r = if a < 0xC000_0000 { a - 0x8000_0000 } else { a };
@@ -53,6 +65,6 @@ pub fn lookup<K: Key, M: BvhMemory + ?Sized>(mem: &M, shape: HashShape, key: K) 
         // keys the same way, and the GPU's 64-bit emulation computes this very expression).
         let h = shape.h as u64;
         let slot = (key.to_u64() % h + d as u64) % h;
-        (NodeRef(mem.hash_cell(slot as u32)), false)
+        (NodeRef(cell(slot as u32)), false)
     }
 }

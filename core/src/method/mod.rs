@@ -136,12 +136,15 @@ impl Method {
     /// The method whose node enumeration this one must equal, closest hit and any hit alike
     /// (for kd methods the enumeration is the sequence of leaves: restarts revisit inner nodes).
     /// A wide method is its own reference: each tree is its own, and its enumeration is checked
-    /// against the scalar reference traversal of the same tree (the serial backend's) instead.
+    /// against the scalar reference traversal of the same tree (the serial backend's) instead;
+    /// but the keyed, stackless `bvh4-hash` must equal the stack traversal `bvh4` of its tree.
     /// So is a stream method, whose enumeration is its packets' leaf lists.
     pub fn reference(self) -> Method {
         match self {
             Method::Bvh2(m) => Method::Bvh2(m.reference()),
             Method::Kd(_) => Method::Kd(KdMethod::Stack),
+            // The keyed wide method visits its stack twin's nodes, in its order.
+            Method::Wide(WideMethod::Bvh4Hash) => Method::Wide(WideMethod::Bvh4),
             Method::Wide(m) => Method::Wide(m),
             Method::Stream(m) => Method::Stream(m),
         }

@@ -23,6 +23,10 @@ pub enum WideMethod {
     /// box tests and answer. Beyond Guthe's paper; for coherent rays (camera rays, shadow rays to
     /// one light).
     Bvh8Packet,
+    /// [`WideMethod::Bvh4`]'s tree and visiting order without a stack ([`crate::wide::trail`]):
+    /// Binder & Keller's node keys, bit trail and perfect hash at two key bits per level, a
+    /// backtrack being one hash lookup and the parent's box tests again. Beyond both papers.
+    Bvh4Hash,
 }
 
 /// How a wide tree is collapsed from the binary one.
@@ -39,8 +43,14 @@ pub enum Collapse {
 
 impl WideMethod {
     /// Every wide method.
-    pub const ALL: [WideMethod; 5] =
-        [WideMethod::Bvh4, WideMethod::Bvh8, WideMethod::Bvh4Naive, WideMethod::Bvh8Sah, WideMethod::Bvh8Packet];
+    pub const ALL: [WideMethod; 6] = [
+        WideMethod::Bvh4,
+        WideMethod::Bvh8,
+        WideMethod::Bvh4Naive,
+        WideMethod::Bvh8Sah,
+        WideMethod::Bvh8Packet,
+        WideMethod::Bvh4Hash,
+    ];
 
     /// Command-line name.
     pub fn name(self) -> &'static str {
@@ -50,13 +60,14 @@ impl WideMethod {
             WideMethod::Bvh4Naive => "bvh4-naive",
             WideMethod::Bvh8Sah => "bvh8-sah",
             WideMethod::Bvh8Packet => "bvh8-packet",
+            WideMethod::Bvh4Hash => "bvh4-hash",
         }
     }
 
     /// Children per node.
     pub fn width(self) -> usize {
         match self {
-            WideMethod::Bvh4 | WideMethod::Bvh4Naive => 4,
+            WideMethod::Bvh4 | WideMethod::Bvh4Naive | WideMethod::Bvh4Hash => 4,
             WideMethod::Bvh8 | WideMethod::Bvh8Sah | WideMethod::Bvh8Packet => 8,
         }
     }
@@ -64,7 +75,7 @@ impl WideMethod {
     /// How the method's tree is collapsed.
     pub fn collapse(self) -> Collapse {
         match self {
-            WideMethod::Bvh4 | WideMethod::Bvh8 | WideMethod::Bvh8Packet => Collapse::PullUp,
+            WideMethod::Bvh4 | WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh4Hash => Collapse::PullUp,
             WideMethod::Bvh8Sah => Collapse::Optimal,
             WideMethod::Bvh4Naive => Collapse::EverySecondLevel,
         }
@@ -75,12 +86,25 @@ impl WideMethod {
         self == WideMethod::Bvh8Packet
     }
 
+    /// Whether the method walks the tree without a stack, by node keys and a perfect hash
+    /// ([`crate::wide::trail`]).
+    pub fn keyed(self) -> bool {
+        self == WideMethod::Bvh4Hash
+    }
+
     /// Per-ray state in bytes for a wide tree of `depth` levels: node address, current entry
     /// distance, stack pointer, and `width - 1` entries of (node, entry distance) per level. A
     /// packet's node, mask and stack (entries of node, ray mask and key) are shared by its
-    /// [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET) rays; each ray adds its box interval.
+    /// [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET) rays; each ray adds its box interval. The
+    /// keyed method keeps the node address, its key and its trail, whatever the depth.
     pub fn state_bytes(self, depth: u32) -> usize {
-        if self.packets() {
+        if self.keyed() {
+            let key = match crate::wide::keyed::wide_key_width::<4>(depth) {
+                Some(crate::key::KeyWidth::W32) => 4,
+                _ => 8,
+            };
+            4 + 2 * key
+        } else if self.packets() {
             let rays = crate::wide::packet::WIDE_PACKET;
             let shared = 8 + 8 + 4 + 16 * (self.width() - 1) * depth as usize;
             8 + shared.div_ceil(rays)

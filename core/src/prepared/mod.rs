@@ -19,8 +19,9 @@ use crate::key::KeyWidth;
 use crate::method::{Bvh2Method, Method, StreamMethod, Structure, WideMethod};
 use crate::scene::Scene;
 use crate::stream::{LevelBvh, StreamScene};
+use crate::wide::keyed::{keyed_nodes, WideHashedMemory};
 use crate::wide::traverse::WideRoot;
-use crate::wide::{WideBvh, WideTree};
+use crate::wide::{WideBvh, WideSliceMemory, WideTree};
 use crate::Error;
 use alloc::vec::Vec;
 
@@ -37,6 +38,8 @@ pub struct PrepareTimings {
     pub kd: f64,
     /// The wide trees.
     pub wide: f64,
+    /// The hash over the 4-wide tree's node keys.
+    pub wide_hash: f64,
     /// The level-order tree of the stream methods.
     pub levels: f64,
 }
@@ -61,6 +64,16 @@ pub struct BuiltHash {
     pub stats: HashStats,
 }
 
+/// A perfect hash over a wide tree's node keys ([`crate::wide::keyed`]), with the key width the
+/// tree's depth needs.
+#[derive(Clone, Debug)]
+pub struct KeyedHash {
+    /// The tables and their construction figures.
+    pub hash: BuiltHash,
+    /// Key and trail width.
+    pub keys: KeyWidth,
+}
+
 /// A scene ready to trace: its canonical BVH2 with exactly the layouts and hash tables the
 /// requested methods use, and its kd-tree if a kd method was requested. A scene traced only with
 /// the stack method pays for no hash, no parent links and no kd-tree.
@@ -80,6 +93,10 @@ pub struct PreparedScene {
     pub kd: Option<PreparedKd>,
     /// The 4-wide tree by Guthe's pull-up ([`WideMethod::Bvh4`]).
     pub wide4: Option<WideBvh<4>>,
+    /// The hash over the 4-wide tree's node keys ([`WideMethod::Bvh4Hash`]), or why there is
+    /// none: a tree deeper than 64-bit keys allow ([`Error::TreeTooDeep`], which only that
+    /// method then returns).
+    pub wide4_hash: Option<Result<KeyedHash, Error>>,
     /// The 8-wide tree by the pull-up ([`WideMethod::Bvh8`], [`WideMethod::Bvh8Packet`]).
     pub wide8: Option<WideBvh<8>>,
     /// The 4-wide tree with every second level removed ([`WideMethod::Bvh4Naive`]).
@@ -155,7 +172,9 @@ impl PreparedScene {
         let t4 = seconds_since(None);
         let wants = |w: WideMethod| methods.contains(&Method::Wide(w));
         let (wide4, wide8, wide4_naive, wide8_sah) = (
-            wants(WideMethod::Bvh4).then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4.collapse())).transpose()?,
+            (wants(WideMethod::Bvh4) || wants(WideMethod::Bvh4Hash))
+                .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4.collapse()))
+                .transpose()?,
             (wants(WideMethod::Bvh8) || wants(WideMethod::Bvh8Packet))
                 .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse()))
                 .transpose()?,
@@ -167,6 +186,18 @@ impl PreparedScene {
                 .transpose()?,
         );
         timings.wide = seconds_since(Some(t4));
+        let t6 = seconds_since(None);
+        let wide4_hash = match &wide4 {
+            Some(tree) if wants(WideMethod::Bvh4Hash) => Some(match keyed_nodes(tree) {
+                Ok((entries, keys)) => {
+                    let (tables, stats) = PerfectHash::build(&entries, tree.nodes().len())?;
+                    Ok(KeyedHash { hash: BuiltHash { tables, stats }, keys })
+                }
+                Err(e) => Err(e),
+            }),
+            _ => None,
+        };
+        timings.wide_hash = seconds_since(Some(t6));
         let t5 = seconds_since(None);
         let levels = if methods.contains(&Method::Stream(StreamMethod::Frustum8)) {
             let bounds = bvh.nodes()[0].bounds;
@@ -186,6 +217,7 @@ impl PreparedScene {
             full_hash,
             kd,
             wide4,
+            wide4_hash,
             wide8,
             wide4_naive,
             wide8_sah,
@@ -268,11 +300,29 @@ impl PreparedScene {
     pub fn wide_tree(&self, method: WideMethod) -> Result<WideTree<'_>, Error> {
         let missing = || Error::NotPrepared { method: method.name(), missing: "its wide tree" };
         Ok(match method {
-            WideMethod::Bvh4 => WideTree::Four(self.wide4.as_ref().ok_or_else(missing)?),
+            WideMethod::Bvh4 | WideMethod::Bvh4Hash => WideTree::Four(self.wide4.as_ref().ok_or_else(missing)?),
             WideMethod::Bvh4Naive => WideTree::Four(self.wide4_naive.as_ref().ok_or_else(missing)?),
             WideMethod::Bvh8 | WideMethod::Bvh8Packet => WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?),
             WideMethod::Bvh8Sah => WideTree::Eight(self.wide8_sah.as_ref().ok_or_else(missing)?),
         })
+    }
+
+    /// The memory of a keyed method ([`WideMethod::keyed`]): its 4-wide tree with the hash over
+    /// its keys, and the key width. [`Error::TreeTooDeep`] for a tree deeper than 64-bit keys
+    /// allow.
+    pub fn wide_keyed(
+        &self,
+        method: WideMethod,
+    ) -> Result<(WideHashedMemory<'_, WideSliceMemory<'_, 4>>, KeyWidth), Error> {
+        let tree = self.wide4.as_ref().filter(|_| method.keyed());
+        let tree = tree.ok_or(Error::NotPrepared { method: method.name(), missing: "its wide tree" })?;
+        let hash =
+            self.wide4_hash.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "its key hash" })?;
+        let hash = hash.as_ref().map_err(Clone::clone)?;
+        let t = &hash.hash.tables;
+        let mem =
+            WideHashedMemory { tree: tree.memory(), displacement: &t.displacement, cells: &t.cells, shape: t.shape };
+        Ok((mem, hash.keys))
     }
 
     /// Where `method` starts, with the BVH2 methods' scene scale (so its slack is theirs).
@@ -301,6 +351,7 @@ impl PreparedScene {
         match method {
             Method::Bvh2(m) => self.memory(m).map(|_| ()),
             Method::Kd(_) => self.kd_memory().map(|_| ()),
+            Method::Wide(m) if m.keyed() => self.wide_keyed(m).map(|_| ()),
             Method::Wide(m) => self.wide_root(m).map(|_| ()),
             Method::Stream(m) => self.stream_scene(m).map(|_| ()),
         }

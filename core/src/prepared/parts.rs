@@ -21,6 +21,8 @@ pub enum Part {
     Kd,
     /// The 4-wide tree by Guthe's pull-up.
     Wide4,
+    /// The perfect hash over the 4-wide tree's node keys.
+    Wide4Hash,
     /// The 8-wide tree by the pull-up.
     Wide8,
     /// The 4-wide tree with every second binary level removed.
@@ -33,13 +35,14 @@ pub enum Part {
 
 impl Part {
     /// Every part, in the order [`PreparedScene::new`] builds them.
-    pub const ALL: [Part; 10] = [
+    pub const ALL: [Part; 11] = [
         Part::UncleLayout,
         Part::ParentLayout,
         Part::Hash,
         Part::FullHash,
         Part::Kd,
         Part::Wide4,
+        Part::Wide4Hash,
         Part::Wide8,
         Part::Wide4Naive,
         Part::Wide8Sah,
@@ -55,6 +58,7 @@ impl Part {
             Part::FullHash => "hash (every node)",
             Part::Kd => "kd-tree",
             Part::Wide4 => "4-wide tree",
+            Part::Wide4Hash => "hash (4-wide node keys)",
             Part::Wide8 => "8-wide tree",
             Part::Wide4Naive => "4-wide tree (naive)",
             Part::Wide8Sah => "8-wide tree (SAH-optimal cut)",
@@ -72,6 +76,7 @@ impl Part {
             Method::Bvh2(_) => &[Part::UncleLayout],
             Method::Kd(_) => &[Part::Kd],
             Method::Wide(WideMethod::Bvh4) => &[Part::Wide4],
+            Method::Wide(WideMethod::Bvh4Hash) => &[Part::Wide4, Part::Wide4Hash],
             Method::Wide(WideMethod::Bvh8 | WideMethod::Bvh8Packet) => &[Part::Wide8],
             Method::Wide(WideMethod::Bvh4Naive) => &[Part::Wide4Naive],
             Method::Wide(WideMethod::Bvh8Sah) => &[Part::Wide8Sah],
@@ -101,6 +106,8 @@ impl PreparedScene {
             Part::FullHash => self.full_hash.as_ref().map(|h| h.stats.bytes),
             Part::Kd => self.kd.as_ref().map(|k| k.tree.bytes() + core::mem::size_of_val(k.triangles.as_slice())),
             Part::Wide4 => self.wide4.as_ref().map(|t| t.bytes()),
+            // A tree too deep for keys holds no tables.
+            Part::Wide4Hash => self.wide4_hash.as_ref().map(|h| h.as_ref().map_or(0, |h| h.hash.stats.bytes)),
             Part::Wide8 => self.wide8.as_ref().map(|t| t.bytes()),
             Part::Wide4Naive => self.wide4_naive.as_ref().map(|t| t.bytes()),
             Part::Wide8Sah => self.wide8_sah.as_ref().map(|t| t.bytes()),
@@ -128,6 +135,7 @@ impl PreparedScene {
                 Part::FullHash => self.full_hash = None,
                 Part::Kd => self.kd = None,
                 Part::Wide4 => self.wide4 = None,
+                Part::Wide4Hash => self.wide4_hash = None,
                 Part::Wide8 => self.wide8 = None,
                 Part::Wide4Naive => self.wide4_naive = None,
                 Part::Wide8Sah => self.wide8_sah = None,

@@ -9,10 +9,13 @@
 //! - [`WideMemory`]: what a traversal reads, in plain slices or with the hit children
 //!   prefetched ([`PrefetchingMemory`], for trees larger than the caches);
 //! - [`traverse`]: the state machine;
+//! - [`trail`]: the same order without a stack, by node keys, a bit trail and a perfect hash over
+//!   the keys ([`keyed`]);
 //! - [`packet`]: the same tree walked by packets of rays of one octant (one order and one stack
 //!   per packet, each ray's own box tests, answers and events).
 
 mod kernel;
+pub mod keyed;
 mod memory;
 pub mod network;
 mod node;
@@ -20,6 +23,7 @@ mod node;
 mod optimal;
 pub mod packet;
 mod prefetch;
+pub mod trail;
 pub mod traverse;
 #[cfg(feature = "alloc")]
 mod tree;

@@ -173,8 +173,8 @@ pub fn structures(p: &PreparedScene) -> String {
             st.depth
         );
     }
-    // The packet method walks bvh8's tree.
-    for m in WideMethod::ALL.into_iter().filter(|m| !m.packets()) {
+    // The packet method walks bvh8's tree, the keyed one bvh4's.
+    for m in WideMethod::ALL.into_iter().filter(|m| !m.packets() && !m.keyed()) {
         if let Ok(t) = p.wide_tree(m) {
             let st = t.stats();
             let w = m.width();

@@ -242,7 +242,7 @@ pub fn simulate(
     let mut run = match method {
         Method::Bvh2(m) => simulate_bvh2(prepared, m, rays, cfg)?,
         Method::Kd(m) => simulate_kd(prepared, m, rays, cfg)?,
-        Method::Wide(m) if !m.packets() => simulate_wide(prepared, m, rays, cfg)?,
+        Method::Wide(m) if !m.packets() && !m.keyed() => simulate_wide(prepared, m, rays, cfg)?,
         _ => return Err(Error::Unsupported { method: method.name(), by: "the lockstep simulator" }),
     };
     run.report.method = method;

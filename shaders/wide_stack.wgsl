@@ -1,0 +1,103 @@
+// Methods bvh4, bvh8, bvh4-naive, bvh8-sah: a wide BVH collapsed from the binary one (Guthe 2014),
+// one state machine for every width (`wide::traverse::WideState`): all children of a node tested,
+// the hit ones nearest first by a bitonic sorting network for closest-hit queries and in slot order
+// for any-hit queries, all but the first pushed with their entry distances, and a popped child
+// dropped when it is entered beyond the closest hit by more than the slack. The node layout, box
+// tests, order and leaf test are wide.wgsl's.
+
+// Stack entries: `W - 1` postponed children on each of 64 levels, the bound behind
+// `wide::traverse::WIDE_STACK` (which holds the 8-wide case for every width). Sized by the width
+// here because a private array this large lives in local memory, and a 4-wide kernel needs less
+// than half of it; a tree never fills either, so both push exactly the CPU's entries.
+const WIDE_STACK: u32 = (WIDE_W - 1u) * 64u;
+
+struct WideEntry {
+    child: u32,
+    count: u32,
+    t_enter: f32,
+}
+
+var<private> WS_CURRENT: WideChild;
+var<private> WS_HAS_CURRENT: bool;
+var<private> WS_LEN: u32;
+var<private> WS_STACK: array<WideEntry, WIDE_STACK>;
+
+// `WideState::pop`.
+fn wide_pop() -> u32 {
+    loop {
+        if WS_LEN == 0u {
+            break;
+        }
+        WS_LEN = WS_LEN - 1u;
+        let e = WS_STACK[WS_LEN];
+        rec_backtrack(0u, VIA_STACK_POP);
+        if e.t_enter > q_limit() + C.t_slack {
+            continue;
+        }
+        WS_CURRENT = WideChild(e.child, e.count);
+        return STEP_CONTINUE;
+    }
+    WS_HAS_CURRENT = false;
+    return STEP_DONE;
+}
+
+// `WideState::step`.
+fn wide_step() -> u32 {
+    if !WS_HAS_CURRENT {
+        return STEP_DONE;
+    }
+    let cur = WS_CURRENT;
+    rec_node(wide_ref(cur));
+    if cur.count != 0u {
+        wide_leaf(cur.child, cur.count);
+        if q_is_answered() {
+            return STEP_DONE;
+        }
+        return wide_pop();
+    }
+    let iv = box_interval(q_limit());
+    let mask = wide_test(cur.child, iv.x, iv.y);
+    if mask == 0u {
+        return wide_pop();
+    }
+    // All hit children but the first pushed, farthest first: for a closest-hit query by rank
+    // after the network, for an any-hit query in descending slot order (unsorted, Sec. 4.2).
+    // Rank and slot run over constants; a miss sorts after every hit, so rank k < n is a hit.
+    // Slot 0 is never pushed: when hit, it is the first.
+    let first_slot = wide_order(mask);
+    let n = countOneBits(mask);
+    for (var j = 1u; j < WIDE_W; j = j + 1u) {
+        let k = WIDE_W - j;
+        let p = wide_push(k, mask, first_slot, n);
+        let slot = p.slot;
+        if p.push && WS_LEN < WIDE_STACK {
+            let s = wide_slot(cur.child, slot);
+            if s.ok {
+                WS_STACK[WS_LEN] = WideEntry(s.c.child, s.c.count, WT_T[k]);
+                WS_LEN = WS_LEN + 1u;
+            }
+        }
+    }
+    let first = wide_slot(cur.child, first_slot);
+    WS_CURRENT = first.c;
+    WS_HAS_CURRENT = first.ok;
+    return STEP_CONTINUE;
+}
+
+// `trace_wide_batch`'s drive loop: the step always runs once, then the budget is checked.
+fn trace(r: Ray) -> Hit {
+    if !begin(r) {
+        return miss();
+    }
+    WS_CURRENT = wide_root();
+    WS_HAS_CURRENT = true;
+    WS_LEN = 0u;
+    var budget = P.max_steps;
+    loop {
+        if wide_step() == STEP_DONE || budget == 0u {
+            break;
+        }
+        budget = budget - 1u;
+    }
+    return Q_HIT;
+}
