@@ -4,7 +4,8 @@
 // siblings left to visit). A backtrack finds the parent of the ancestor whose siblings are due
 // through the perfect hash over the node keys (hash.wgsl), tests that parent's children again over
 // [tmin - slack, +inf] and takes the next one in the visiting order entered within the slack of
-// the closest hit (`wide::trail::backtrack`, `successor`). Keys and trails are the keys file's
+// the closest hit (`wide::trail::backtrack`, `successor`); a register holding the parent of the
+// trail's lowest level, where known, spares most lookups. Keys and trails are the keys file's
 // (32 bits, or a pair of words for trees deeper than 15 levels); WK_BITS, the key bits per level,
 // comes in the generated header.
 
@@ -20,6 +21,10 @@ struct WideBacktrack {
     key: Key,
     trail: Key,
 }
+
+// The register: the parent of the level of the trail's lowest set bit, when WK_REG_OK.
+var<private> WK_REG: u32;
+var<private> WK_REG_OK: bool;
 
 // `wide::trail::successor` over WT_T (entry distances, +inf for a miss) and the hit `mask` from
 // `wide_test`: the least child after `slot` entered within `reach`, by (distance, slot) or by slot
@@ -69,20 +74,29 @@ fn wk_backtrack(key_in: Key, trail_in: Key) -> WideBacktrack {
         let ancestor = key_shr(key, WK_BITS * n);
         let slot = key_low_u32(ancestor) & (WIDE_W - 1u);
         let parent_key = key_shr(ancestor, WK_BITS);
-        let found = hash_lookup(parent_key);
-        rec_backtrack(n, VIA_HASH + found.y);
+        var parent = WK_REG;
+        if WK_REG_OK {
+            rec_backtrack(n, VIA_REGISTER);
+        } else {
+            let found = hash_lookup(parent_key);
+            rec_backtrack(n, VIA_HASH + found.y);
+            parent = found.x;
+        }
+        WK_REG_OK = false;
         let iv = box_interval(q_limit());
-        let mask = wide_test(found.x, iv.x, bitcast<f32>(0x7f800000u));
+        let mask = wide_test(parent, iv.x, bitcast<f32>(0x7f800000u));
         key = ancestor;
         trail = key_xor(key_shr(trail, n), key_one());
         let next = wk_successor(mask, slot, q_limit() + C.t_slack);
         if next.slot < WIDE_W {
-            let s = wide_slot(found.x, next.slot);
+            let s = wide_slot(parent, next.slot);
             if !s.ok {
                 break;
             }
             if next.count > 1u {
                 trail = key_or(trail, key_one());
+                WK_REG = parent;
+                WK_REG_OK = true;
             }
             return WideBacktrack(true, s.c, wk_child(parent_key, next.slot), trail);
         }
@@ -98,6 +112,7 @@ fn trace(r: Ray) -> Hit {
     var cur = wide_root();
     var key = key_root();
     var trail = key_zero();
+    WK_REG_OK = false;
     var budget = P.max_steps;
     loop {
         rec_node(wide_ref(cur));
@@ -109,10 +124,11 @@ fn trace(r: Ray) -> Hit {
             }
         } else {
             let iv = box_interval(q_limit());
-            let mask = wide_test(cur.child, iv.x, iv.y);
+            let cur_node = cur.child;
+            let mask = wide_test(cur_node, iv.x, iv.y);
             if mask != 0u {
                 let first_slot = wide_order(mask);
-                let first = wide_slot(cur.child, first_slot);
+                let first = wide_slot(cur_node, first_slot);
                 if !first.ok {
                     break;
                 }
@@ -121,6 +137,8 @@ fn trace(r: Ray) -> Hit {
                 trail = key_shl(trail, 1u);
                 if countOneBits(mask) > 1u {
                     trail = key_or(trail, key_one());
+                    WK_REG = cur_node;
+                    WK_REG_OK = true;
                 }
                 descended = true;
             }

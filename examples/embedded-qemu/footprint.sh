@@ -16,7 +16,7 @@ run() {
 base=$(run none | awk '/^footprint/ {print $3}')
 printf '%-16s %10s %12s %10s %11s %9s\n' method "text B" "method code" "rodata B" "insns/ray" "stack B"
 printf '%-16s %10s %12s %10s %11s %9s\n' "(scaffold)" "$base" 0 - - -
-for i in $(seq 0 12); do
+for i in $(seq 0 13); do
   out=$(run "$i")
   text=$(awk '/^footprint/ {print $3}' <<<"$out")
   rodata=$(awk '/^footprint/ {print $5}' <<<"$out")

@@ -11,6 +11,7 @@
 
 use raytrail_core::bvh2::{BinaryLayout, SahBuilder, SahConfig};
 use raytrail_core::hash::PerfectHash;
+use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Bvh2Method, KdMethod, Method, WideMethod};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::wide::{WideChild, WideTree};
@@ -43,13 +44,16 @@ fn main() {
     // parent/sibling needs its own layout and only hash-resume the hash over every node. Every
     // kd method reads the one kd-tree; the 4-wide BVH (Guthe's pull-up) is the wide tree baked.
     let mut methods = Method::BVH2.to_vec();
-    methods.extend([Method::Kd(KdMethod::Stack), Method::Wide(WideMethod::Bvh4)]);
+    methods.extend([Method::Kd(KdMethod::Stack), Method::Wide(WideMethod::Bvh4), Method::Wide(WideMethod::Bvh4Hash)]);
     let prepared = PreparedScene::new(&scene, bvh, &methods).expect("the sphereflake prepares");
 
     let uncles = prepared.layout(Bvh2Method::Uncle).expect("uncle layout prepared");
     let parents = prepared.layout(Bvh2Method::ParentSibling).expect("parent/sibling layout prepared");
     let hash = &prepared.hash.as_ref().expect("hash prepared").tables;
     let full_hash = &prepared.full_hash.as_ref().expect("full hash prepared").tables;
+    let wide_keyed = prepared.wide4_hash.as_ref().expect("4-wide key hash prepared").as_ref().expect("4-wide keys");
+    assert_eq!(wide_keyed.keys, KeyWidth::W32, "the 4-wide tree needs 64-bit keys; the example uses u32");
+    let wide_hash = &wide_keyed.hash.tables;
 
     let bytes = [
         write_layout(out, "uncle", uncles),
@@ -58,6 +62,7 @@ fn main() {
         write_hash(out, "full_hash", full_hash),
         write_kd(out, &prepared),
         write_wide(out, &prepared),
+        write_hash(out, "wide_hash", wide_hash),
     ];
 
     let root = prepared.root(Bvh2Method::Stack).expect("root");
@@ -86,8 +91,12 @@ fn main() {
         konst(w, &format!("Leaf words of the {what} layout."), &format!("{name}_LEAF_WORDS"), "usize", l.leaves.len());
         konst(w, &format!("Root reference of the {what} layout."), &format!("{name}_ROOT"), "u32", l.root.0);
     }
-    for (name, h) in [("HASH", hash), ("FULL_HASH", full_hash)] {
-        let what = if name == "HASH" { "hash over backtracking targets" } else { "hash over every node" };
+    for (name, h) in [("HASH", hash), ("FULL_HASH", full_hash), ("WIDE_HASH", wide_hash)] {
+        let what = match name {
+            "HASH" => "hash over backtracking targets",
+            "FULL_HASH" => "hash over every node",
+            _ => "hash over the 4-wide node keys",
+        };
         konst(w, &format!("`D - 1` of the {what}."), &format!("{name}_D_MASK"), "u32", h.shape.d_mask);
         konst(w, &format!("`H` of the {what}."), &format!("{name}_H"), "u32", h.shape.h);
         konst(
@@ -135,7 +144,7 @@ fn main() {
     std::fs::write(out.join("baked.rs"), rs).expect("write baked.rs");
 
     if std::env::var_os(FOOTPRINT_ENV).is_some_and(|v| !v.is_empty() && v != "0") {
-        footprint(&prepared, uncles, parents, hash, full_hash);
+        footprint(&prepared, uncles, parents, [hash, full_hash, wide_hash]);
     }
 }
 
@@ -239,7 +248,7 @@ fn floats(w: &mut String, doc: &str, name: &str, v: [f32; 3]) {
 }
 
 /// The flash footprint, table by table, and the per-ray state of each method.
-fn footprint(p: &PreparedScene, uncles: &BinaryLayout, parents: &BinaryLayout, hash: &PerfectHash, full: &PerfectHash) {
+fn footprint(p: &PreparedScene, uncles: &BinaryLayout, parents: &BinaryLayout, hashes: [&PerfectHash; 3]) {
     let s = p.bvh.stats();
     let warn = |s: String| println!("cargo:warning={s}");
     warn(format!(
@@ -255,7 +264,8 @@ fn footprint(p: &PreparedScene, uncles: &BinaryLayout, parents: &BinaryLayout, h
         total += n + lw;
         warn(format!("{name}: nodes {n} B ({} x 64), leaf words {lw} B ({} x 16)", l.nodes.len(), l.leaves.len()));
     }
-    for (name, h) in [("hash (backtracking targets)", hash), ("hash (every node)", full)] {
+    let names = ["hash (backtracking targets)", "hash (every node)", "hash (4-wide node keys)"];
+    for (name, h) in names.into_iter().zip(hashes) {
         let (d, c) = (h.displacement.len() * 4, h.cells.len() * 4);
         total += d + c;
         warn(format!("{name}: displacement {d} B, cells {c} B"));

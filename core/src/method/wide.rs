@@ -96,14 +96,15 @@ impl WideMethod {
     /// distance, stack pointer, and `width - 1` entries of (node, entry distance) per level. A
     /// packet's node, mask and stack (entries of node, ray mask and key) are shared by its
     /// [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET) rays; each ray adds its box interval. The
-    /// keyed method keeps the node address, its key and its trail, whatever the depth.
+    /// keyed method keeps the node address, its key, its trail and a register (a parent node),
+    /// whatever the depth.
     pub fn state_bytes(self, depth: u32) -> usize {
         if self.keyed() {
             let key = match crate::wide::keyed::wide_key_width::<4>(depth) {
                 Some(crate::key::KeyWidth::W32) => 4,
                 _ => 8,
             };
-            4 + 2 * key
+            4 + 2 * key + 4
         } else if self.packets() {
             let rays = crate::wide::packet::WIDE_PACKET;
             let shared = 8 + 8 + 4 + 16 * (self.width() - 1) * depth as usize;

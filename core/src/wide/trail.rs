@@ -13,6 +13,12 @@
 //! ancestor's slot in the visiting order among those still worth visiting. That is one hash
 //! lookup and one node's box tests per backtrack, whatever the depth, instead of a stack pop.
 //!
+//! **A register** spares most lookups, as Binder & Keller's most-recently-postponed-node register
+//! does for the binary tree: it holds the parent of the level of the trail's lowest set bit, when
+//! known. A node whose expansion leaves siblings to visit writes itself there; a backtrack that
+//! finds more siblings after the one it takes keeps it; one that exhausts its level empties it
+//! (the parent of the next level up is not known, so the hash finds it).
+//!
 //! **The same nodes as the stack traversal, in the same order.** The stack pushes a node's hit
 //! children after the first in the visiting order, and pops each when its entry distance is within
 //! the slack of the closest hit (`t_enter <= limit + slack`). The re-test here runs over
@@ -31,7 +37,7 @@ use super::traverse::{leaf, visiting_order, WideRayContext, WideRoot};
 use crate::intersect::TriangleTest;
 use crate::key::Key;
 use crate::method::Query;
-use crate::observe::{Backtrack, Observer};
+use crate::observe::{Backtrack, Observer, RegisterSource};
 use crate::traverse::{for_each_ray, QueryState};
 use crate::{Hit, Ray};
 
@@ -46,6 +52,8 @@ pub fn run<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTe
     obs: &mut O,
 ) {
     let (mut current, mut key, mut trail, mut budget) = (root.root, K::ONE, K::ZERO, root.max_steps);
+    // The parent of the level of the trail's lowest set bit, where known.
+    let mut register = None;
     loop {
         obs.node(current.node_ref());
         let mut descended = false;
@@ -61,6 +69,9 @@ pub fn run<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTe
                     current = first;
                     key = child_key::<W, K>(key, order[0]);
                     trail = trail.shl(1) | if n > 1 { K::ONE } else { K::ZERO };
+                    if n > 1 {
+                        register = Some(index);
+                    }
                     descended = true;
                 }
             }
@@ -72,7 +83,9 @@ pub fn run<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTe
             }
         }
         if !descended {
-            let Some((next, k, t)) = backtrack::<W, K, M, T, C, O>(mem, key, trail, ctx, q, obs) else { return };
+            let Some((next, k, t)) = backtrack::<W, K, M, T, C, O>(mem, key, trail, &mut register, ctx, q, obs) else {
+                return;
+            };
             (current, key, trail) = (next, k, t);
         }
         if budget == 0 {
@@ -83,12 +96,15 @@ pub fn run<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTe
 }
 
 /// The next child to visit after the subtree of the node keyed `key` is done, with its key and
-/// trail, or `None` when the trail runs out (the ray is done).
+/// trail, or `None` when the trail runs out (the ray is done). `register` is the parent of the
+/// first level tried, where known, and is left holding the parent of the returned child's level
+/// when more of its siblings remain.
 #[inline(always)]
 fn backtrack<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTest, C: ChildKernel, O: Observer>(
     mem: &M,
     mut key: K,
     mut trail: K,
+    register: &mut Option<u32>,
     ctx: &WideRayContext<T>,
     q: &QueryState,
     obs: &mut O,
@@ -100,8 +116,17 @@ fn backtrack<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: Triangle
         let ancestor = key.shr(b * n);
         let slot = ancestor.low_u32() & (W as u32 - 1);
         let parent_key = ancestor.shr(b);
-        let (parent, direct) = mem.keyed_node(parent_key);
-        obs.backtrack(n, Backtrack::Hash { direct });
+        let parent = match register.take() {
+            Some(p) => {
+                obs.backtrack(n, Backtrack::Register(RegisterSource::Postponed));
+                p
+            }
+            None => {
+                let (p, direct) = mem.keyed_node(parent_key);
+                obs.backtrack(n, Backtrack::Hash { direct });
+                p
+            }
+        };
         let node = mem.wide_node(parent);
         let (lo, _) = ctx.box_interval(q.limit());
         let hits = C::test::<W>(&node, &ctx.slab, lo, f32::INFINITY);
@@ -110,8 +135,11 @@ fn backtrack<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: Triangle
         let (next, more) = successor(&hits, slot, q.limit() + ctx.t_slack, q.any && !C::SORTED_ANY);
         if let Some(s) = next {
             let child = node.child_ref(s as usize)?;
-            let bit = if more { K::ONE } else { K::ZERO };
-            return Some((child, child_key::<W, K>(parent_key, s), trail | bit));
+            if more {
+                *register = Some(parent);
+                trail = trail | K::ONE;
+            }
+            return Some((child, child_key::<W, K>(parent_key, s), trail));
         }
     }
     None

@@ -137,6 +137,7 @@ const GRIDS: [fn(&FlashScene); METHODS.len()] = [
     trace_grid::<10>,
     trace_grid::<11>,
     trace_grid::<12>,
+    trace_grid::<13>,
 ];
 
 /// The 4-wide BVH over the whole grid as one batch per query: the core's batch entry point sets

@@ -31,6 +31,8 @@ use raytrail_core::intersect::{TriangleBlock, Watertight};
 use raytrail_core::kd::traverse::{trace_kd_ray, KdRoot};
 use raytrail_core::kd::KdNode;
 pub use raytrail_core::observe::{Counters, NoObserver, Observer};
+use raytrail_core::wide::keyed::WideHashedMemory;
+use raytrail_core::wide::trail::trace_wide_trail_batch;
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{FastKernel, WideChild, WideNode};
 
@@ -42,10 +44,12 @@ pub use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query, WideMethod}
 pub use raytrail_core::{Hit, Ray};
 pub use wide::WideFlashMemory;
 
-/// Every method the device offers: the seven BVH2 methods, the five kd methods and the 4-wide BVH
-/// (the 8-wide and naive 4-wide trees are not baked).
-pub const METHODS: [Method; 13] = {
-    let mut out = [Method::Wide(WideMethod::Bvh4); 13];
+/// Every method the device offers: the seven BVH2 methods, the five kd methods, and the 4-wide BVH
+/// with its stack (bvh4) and without (bvh4-hash, 16 bytes of state per ray); the 8-wide and naive
+/// 4-wide trees are not baked.
+pub const METHODS: [Method; 14] = {
+    let mut out = [Method::Wide(WideMethod::Bvh4); 14];
+    out[13] = Method::Wide(WideMethod::Bvh4Hash);
     let mut i = 0;
     while i < Method::BVH2.len() + Method::KD.len() {
         out[i] = if i < Method::BVH2.len() { Method::BVH2[i] } else { Method::KD[i - Method::BVH2.len()] };
@@ -85,6 +89,8 @@ static KD_TRIANGLES_BYTES: &Aligned<[u8]> = table!("kd_triangles.bin");
 static WIDE_NODES_BYTES: &Aligned<[u8]> = table!("wide_nodes.bin");
 static WIDE_BLOCKS_BYTES: &Aligned<[u8]> = table!("wide_blocks.bin");
 static WIDE_PRIMS_BYTES: &Aligned<[u8]> = table!("wide_prims.bin");
+static WIDE_HASH_DISPLACEMENT_BYTES: &Aligned<[u8]> = table!("wide_hash_displacement.bin");
+static WIDE_HASH_CELLS_BYTES: &Aligned<[u8]> = table!("wide_hash_cells.bin");
 
 /// A baked table that does not have the size, alignment or shape the build script recorded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -165,6 +171,7 @@ pub struct FlashScene {
     full_hash: HashTables,
     kd: KdFlashMemory<'static>,
     wide: WideFlashMemory<'static>,
+    wide_hash: HashTables,
 }
 
 /// Views a table as `T`s, checking alignment, size and the element count recorded at build time.
@@ -250,6 +257,13 @@ impl FlashScene {
             )?,
             kd: kd_tables()?,
             wide: wide_tables()?,
+            wide_hash: hash_tables(
+                WIDE_HASH_DISPLACEMENT_BYTES,
+                WIDE_HASH_CELLS_BYTES,
+                (b::WIDE_HASH_DISPLACEMENTS, b::WIDE_HASH_CELLS),
+                HashShape { d_mask: b::WIDE_HASH_D_MASK, h: b::WIDE_HASH_H },
+                "wide hash",
+            )?,
         })
     }
 
@@ -316,6 +330,12 @@ impl FlashScene {
         self.wide
     }
 
+    /// The 4-wide BVH's tables with the hash over its node keys (bvh4-hash).
+    pub fn wide_keyed_memory(&self) -> WideHashedMemory<'static, WideFlashMemory<'static>> {
+        let h = self.wide_hash;
+        WideHashedMemory { tree: self.wide, displacement: h.displacement, cells: h.cells, shape: h.shape }
+    }
+
     /// Traces one ray with any method of [`METHODS`], reporting to `obs`; `None` for a method
     /// whose tables are not baked (the 8-wide and naive 4-wide BVHs). Always inlined, so that a
     /// caller with a constant method keeps only that method's code and state (one function with
@@ -327,6 +347,20 @@ impl FlashScene {
             Method::Kd(m) => trace_kd_ray::<_, Watertight, _>(m, &self.kd, &self.kd_root(), ray, query, obs),
             Method::Wide(WideMethod::Bvh4) => {
                 trace_wide_ray::<4, _, Watertight, FastKernel, _>(&self.wide, self.wide_root(), ray, query, obs)
+            }
+            Method::Wide(WideMethod::Bvh4Hash) => {
+                let mut hit = Hit::MISS;
+                let (rays, hits) = (core::slice::from_ref(ray), core::slice::from_mut(&mut hit));
+                let mem = self.wide_keyed_memory();
+                trace_wide_trail_batch::<4, u32, _, Watertight, FastKernel, _>(
+                    &mem,
+                    self.wide_root(),
+                    rays,
+                    hits,
+                    query,
+                    obs,
+                );
+                hit
             }
             _ => return None,
         })
@@ -478,7 +512,9 @@ mod tests {
         let host = raytrail_conformance::scenes::sphereflake(baked::SPHEREFLAKE_DEPTH);
         let config = raytrail_core::bvh2::SahConfig { max_depth: 31, ..Default::default() };
         let bvh = raytrail_core::bvh2::SahBuilder::new(config).build(host.triangles()).expect("build");
-        let prepared = PreparedScene::new(&host, bvh, &[KdMethod::Stack.into(), WideMethod::Bvh4.into()]).unwrap();
+        let methods = [KdMethod::Stack.into(), WideMethod::Bvh4.into(), WideMethod::Bvh4Hash.into()];
+        let prepared = PreparedScene::new(&host, bvh, &methods).unwrap();
+        let (keyed, _) = prepared.wide_keyed(WideMethod::Bvh4Hash).unwrap();
         let (kd_mem, kd_root) = (prepared.kd_memory().unwrap(), prepared.kd_root().unwrap());
         let raytrail_core::wide::WideTree::Four(wide) = prepared.wide_tree(WideMethod::Bvh4).unwrap() else {
             panic!("bvh4 is four wide")
@@ -494,6 +530,19 @@ mod tests {
                     let want = match m {
                         Method::Kd(k) => {
                             trace_kd_ray::<_, Watertight, _>(k, &kd_mem, &kd_root, &ray, query, &mut want_c)
+                        }
+                        Method::Wide(WideMethod::Bvh4Hash) => {
+                            let mut hit = Hit::MISS;
+                            let (r, h) = (core::slice::from_ref(&ray), core::slice::from_mut(&mut hit));
+                            trace_wide_trail_batch::<4, u32, _, Watertight, FastKernel, _>(
+                                &keyed,
+                                wide_root,
+                                r,
+                                h,
+                                query,
+                                &mut want_c,
+                            );
+                            hit
                         }
                         _ => trace_wide_ray::<4, _, Watertight, FastKernel, _>(
                             &wide.memory(),
