@@ -43,10 +43,11 @@ struct WideRun<'a> {
 }
 
 impl WideRun<'_> {
-    /// Prefetches hit children where that pays ([`worth_prefetching`]).
+    /// Prefetches hit children where that pays ([`worth_prefetching`]; never in the packet loop,
+    /// which does not prefetch, so it is not compiled twice).
     fn go<const W: usize>(&self, mem: WideSliceMemory<'_, W>, chunk: Chunk<'_>) -> Result<Counters, Error> {
         let bytes = core::mem::size_of_val(mem.nodes) + core::mem::size_of_val(mem.blocks);
-        if worth_prefetching(bytes, chunk.rays, self.opts.query) {
+        if !self.method.packets() && worth_prefetching(bytes, chunk.rays, self.opts.query) {
             self.test(&PrefetchingMemory(mem), chunk)
         } else {
             self.test(&mem, chunk)

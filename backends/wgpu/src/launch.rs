@@ -122,19 +122,16 @@ pub(crate) fn launch<'a>(
                 WideChild::Node(n) => (n, 0),
                 WideChild::Leaf { first, count } => (NodeRef::leaf(first).0, count),
             };
-            let hash = match &scene.wide4_hash {
-                Some(h) if m.keyed() => {
-                    // Fails with the scene's reason where it holds no tables (a tree too deep).
-                    p.wide_keyed(m)?;
-                    params.d_mask = h.d_mask;
-                    params.h = h.h;
-                    &h.buffer
-                }
-                None if m.keyed() => {
-                    p.wide_keyed(m)?;
-                    return Err(Error::NotPrepared { method: m.name(), missing: "its key hash" });
-                }
-                _ => &scene.empty,
+            let hash = if m.keyed() {
+                // Fails with the scene's reason where it holds no tables (a tree too deep).
+                p.wide_keyed(m)?;
+                let missing = Error::NotPrepared { method: m.name(), missing: "its key hash" };
+                let h = scene.wide4_hash.as_ref().ok_or(missing)?;
+                params.d_mask = h.d_mask;
+                params.h = h.h;
+                &h.buffer
+            } else {
+                &scene.empty
             };
             SceneBindings { bvh: &scene.empty, hash, kd: &tree.buffer }
         }

@@ -186,7 +186,7 @@ impl PreparedScene {
                 .transpose()?,
         );
         timings.wide = seconds_since(Some(t4));
-        let t6 = seconds_since(None);
+        let t_hash = seconds_since(None);
         let wide4_hash = match &wide4 {
             Some(tree) if wants(WideMethod::Bvh4Hash) => Some(match keyed_nodes(tree) {
                 Ok((entries, keys)) => {
@@ -197,7 +197,7 @@ impl PreparedScene {
             }),
             _ => None,
         };
-        timings.wide_hash = seconds_since(Some(t6));
+        timings.wide_hash = seconds_since(Some(t_hash));
         let t5 = seconds_since(None);
         let levels = if methods.contains(&Method::Stream(StreamMethod::Frustum8)) {
             let bounds = bvh.nodes()[0].bounds;

@@ -1,7 +1,8 @@
 //! Stackless traversal of a wide BVH: Binder & Keller's (2016) node keys, bit trail and perfect
 //! hash carried from two children per node to `W` (keys of [`super::keyed`]). Beyond both papers:
-//! a ray's whole state is its current child, its key and its trail (two registers), where the
-//! stack traversal ([`super::traverse`]) keeps up to `W - 1` entries per level.
+//! a ray's whole state is its current child, its key, its trail and one register (16 bytes with
+//! 32-bit keys), where the stack traversal ([`super::traverse`]) keeps up to `W - 1` entries per
+//! level.
 //!
 //! **The trail** has one bit per level, relative to the current node as in the binary method: bit
 //! `i` is set where the ancestor `i` levels up (bit 0: the node itself) may still have siblings to

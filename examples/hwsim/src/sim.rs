@@ -229,9 +229,10 @@ pub struct MethodRun {
 
 /// Simulates `method` over `rays` in lockstep warps, with the watertight triangle test: any BVH2
 /// method (with the key width the tree needs), the kd methods but the packet one, and every wide
-/// method but the packet one. kd-packet and bvh8-packet are lockstep units of their own (rays
-/// sharing a node) and are an [`Error::Unsupported`], as is a method `prepared` lacks the tables
-/// of ([`Error::NotPrepared`]).
+/// method but the packet one and the keyed one. kd-packet and bvh8-packet are lockstep units of
+/// their own (rays sharing a node) and bvh4-hash runs as one loop per ray, not a step function;
+/// they are an [`Error::Unsupported`], as is a method `prepared` lacks the tables of
+/// ([`Error::NotPrepared`]).
 pub fn simulate(
     prepared: &PreparedScene,
     method: impl Into<Method>,

@@ -87,7 +87,7 @@ fn check_all(s: &Scenario, rays: &[Ray], query: Query, warp: usize) {
             _ => assert_eq!((r.stack_pushes, r.transitions.stack_pop, r.stack_bytes_per_ray()), (0, 0, None), "{m}"),
         }
     }
-    for m in WideMethod::ALL.into_iter().filter(|m| !m.packets()).map(Method::Wide) {
+    for m in WideMethod::ALL.into_iter().filter(|m| !m.packets() && !m.keyed()).map(Method::Wide) {
         let r = check(s, m, rays, query, warp, &stack).report;
         if query == Query::Closest {
             // A closest-hit wide traversal ends with an empty stack: every entry is popped
@@ -160,4 +160,11 @@ fn kd_packet_is_refused_with_a_typed_error() {
     let s = Scenario::new(sphereflake(1), RayKind::Primary, 4, 4).unwrap();
     let got = simulate(&s.prepared, KdMethod::Packet, &s.rays, &SimConfig::new(Query::Closest));
     assert!(matches!(got.err(), Some(Error::Unsupported { method: "kd-packet", .. })));
+}
+
+#[test]
+fn the_keyed_wide_method_is_refused_with_a_typed_error() {
+    let s = Scenario::new(sphereflake(1), RayKind::Primary, 4, 4).unwrap();
+    let got = simulate(&s.prepared, WideMethod::Bvh4Hash, &s.rays, &SimConfig::new(Query::Closest));
+    assert!(matches!(got.err(), Some(Error::Unsupported { method: "bvh4-hash", .. })));
 }
