@@ -14,7 +14,7 @@ use raytrail_core::stream::{trace_stream_with, FrustumCull, Serial};
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::keyed::WideKeyedMemory;
 use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
-use raytrail_core::wide::trail::trace_wide_trail_batch;
+use raytrail_core::wide::trail::trace_wide_trail_ray;
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{ReferenceKernel, WideSliceMemory, WideTree};
 use raytrail_core::{Error, Hit, Ray};
@@ -145,10 +145,7 @@ impl SerialBackend {
         rays.iter()
             .map(|ray| {
                 let mut o = Both(Counters::default(), Recorder::default());
-                let mut hit = Hit::MISS;
-                let (r, h) = (std::slice::from_ref(ray), std::slice::from_mut(&mut hit));
-                trace_wide_trail_batch::<4, K, M, T, ReferenceKernel, _>(mem, root, r, h, query, &mut o);
-                (hit, o)
+                (trace_wide_trail_ray::<4, K, M, T, ReferenceKernel, _>(mem, root, ray, query, &mut o), o)
             })
             .collect()
     }

@@ -193,6 +193,28 @@ pub fn trace_wide_trail_batch<
     });
 }
 
+/// Traces one ray over a `W`-wide tree without a stack; see [`trace_wide_trail_batch`].
+#[inline]
+pub fn trace_wide_trail_ray<
+    const W: usize,
+    K: Key,
+    M: WideKeyedMemory<W> + ?Sized,
+    T: TriangleTest,
+    C: ChildKernel,
+    O: Observer,
+>(
+    mem: &M,
+    root: WideRoot,
+    ray: &Ray,
+    query: Query,
+    obs: &mut O,
+) -> Hit {
+    let mut hit = Hit::MISS;
+    let (rays, hits) = (core::slice::from_ref(ray), core::slice::from_mut(&mut hit));
+    trace_wide_trail_batch::<W, K, M, T, C, O>(mem, root, rays, hits, query, obs);
+    hit
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -32,7 +32,7 @@ use raytrail_core::kd::traverse::{trace_kd_ray, KdRoot};
 use raytrail_core::kd::KdNode;
 pub use raytrail_core::observe::{Counters, NoObserver, Observer};
 use raytrail_core::wide::keyed::WideHashedMemory;
-use raytrail_core::wide::trail::trace_wide_trail_batch;
+use raytrail_core::wide::trail::trace_wide_trail_ray;
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{FastKernel, WideChild, WideNode};
 
@@ -348,20 +348,13 @@ impl FlashScene {
             Method::Wide(WideMethod::Bvh4) => {
                 trace_wide_ray::<4, _, Watertight, FastKernel, _>(&self.wide, self.wide_root(), ray, query, obs)
             }
-            Method::Wide(WideMethod::Bvh4Hash) => {
-                let mut hit = Hit::MISS;
-                let (rays, hits) = (core::slice::from_ref(ray), core::slice::from_mut(&mut hit));
-                let mem = self.wide_keyed_memory();
-                trace_wide_trail_batch::<4, u32, _, Watertight, FastKernel, _>(
-                    &mem,
-                    self.wide_root(),
-                    rays,
-                    hits,
-                    query,
-                    obs,
-                );
-                hit
-            }
+            Method::Wide(WideMethod::Bvh4Hash) => trace_wide_trail_ray::<4, u32, _, Watertight, FastKernel, _>(
+                &self.wide_keyed_memory(),
+                self.wide_root(),
+                ray,
+                query,
+                obs,
+            ),
             _ => return None,
         })
     }
@@ -532,17 +525,13 @@ mod tests {
                             trace_kd_ray::<_, Watertight, _>(k, &kd_mem, &kd_root, &ray, query, &mut want_c)
                         }
                         Method::Wide(WideMethod::Bvh4Hash) => {
-                            let mut hit = Hit::MISS;
-                            let (r, h) = (core::slice::from_ref(&ray), core::slice::from_mut(&mut hit));
-                            trace_wide_trail_batch::<4, u32, _, Watertight, FastKernel, _>(
+                            trace_wide_trail_ray::<4, u32, _, Watertight, FastKernel, _>(
                                 &keyed,
                                 wide_root,
-                                r,
-                                h,
+                                &ray,
                                 query,
                                 &mut want_c,
-                            );
-                            hit
+                            )
                         }
                         _ => trace_wide_ray::<4, _, Watertight, FastKernel, _>(
                             &wide.memory(),
