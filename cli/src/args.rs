@@ -67,8 +67,9 @@ pub fn usage<T>(m: impl Into<String>) -> Result<T, Failure> {
 const AFTER_HELP: &str = "\
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
          kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree);
-         bvh4, bvh8, bvh4-naive, bvh8-sah (wide BVH); stream (ray stream);
-         auto (trace's default; bench --methods): the fastest of bvh8, kd-stack, stack and stream
+         bvh4, bvh8, bvh4-naive, bvh8-sah, bvh8-packet, bvh4-hash (wide BVH); stream (ray stream);
+         auto (trace's default; bench --methods): the fastest of bvh8, bvh8-packet, kd-stack, stack
+         and stream
          timed on a sample of the rays (`raytrail explain SCENE` shows the choice per ray type)
 SCENES:  OBJ, PLY (ASCII or binary), OFF, STL (ASCII or binary), glTF 2.0 (.gltf, .glb), any of them
          gzip-compressed; `builtin` is a generated sphereflake. Elements that are not triangles or
@@ -598,5 +599,15 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&out).unwrap(), format!("prim,file,line\n0,{path},7\n"));
         let e = write_prim_map("/nonexistent/dir/map.csv", &path, &report).unwrap_err();
         assert!(e.starts_with("cannot write /nonexistent/dir/map.csv: "), "{e}");
+    }
+
+    #[test]
+    fn help_lists_every_method() {
+        // The list in the help is written by hand; this keeps it in step with the methods.
+        let listed: Vec<&str> =
+            AFTER_HELP.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-')).filter(|w| !w.is_empty()).collect();
+        for method in Method::ALL {
+            assert!(listed.contains(&method.name()), "the help's METHODS list lacks {method}");
+        }
     }
 }
