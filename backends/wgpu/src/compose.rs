@@ -83,11 +83,12 @@ pub enum DispatchKind {
     Persistent,
 }
 
-impl From<Dispatch> for DispatchKind {
-    fn from(d: Dispatch) -> Self {
-        match d {
-            Dispatch::Grid => DispatchKind::Grid,
+impl DispatchKind {
+    /// The dispatch file `method` compiles under `dispatch` ([`Dispatch::for_method`]).
+    pub fn of(dispatch: Dispatch, method: Method) -> DispatchKind {
+        match dispatch.for_method(method) {
             Dispatch::Persistent { .. } => DispatchKind::Persistent,
+            Dispatch::Grid | Dispatch::ByMethod => DispatchKind::Grid,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! parameters, and the packet kernels' arrangement of rays into packets.
 
 use crate::batch::Launch;
-use crate::compose::Variant;
+use crate::compose::{DispatchKind, Variant};
 use crate::config::{Dispatch, GpuConfig};
 use crate::params::Params;
 use crate::record;
@@ -27,7 +27,7 @@ pub(crate) fn variant(scene: &WgpuScene, options: &TraceOptions, config: &GpuCon
         triangle: options.triangle_test,
         query: options.query,
         record: options.record,
-        dispatch: config.dispatch.into(),
+        dispatch: DispatchKind::of(config.dispatch, options.method),
         workgroup_size: config.workgroup_size,
     }
 }
@@ -41,14 +41,14 @@ fn keys_for(scene: &WgpuScene, method: Method) -> KeyWidth {
     }
 }
 
-/// `config` as `method` runs under it: the wide packet kernel is a packet to a workgroup, so its
-/// work items are packets handed out one workgroup each (`grid` counts workgroups as items per
-/// workgroup size), on the grid.
+/// `config` as `method` runs under it: the dispatch resolved ([`Dispatch::for_method`]); the wide
+/// packet kernel is a packet to a workgroup, so its work items are packets handed out one
+/// workgroup each (`grid` counts workgroups as items per workgroup size), on the grid.
 fn for_method(method: Method, config: GpuConfig) -> GpuConfig {
     if is_wide_packet(method) {
         GpuConfig { workgroup_size: 1, dispatch: Dispatch::Grid, ..config }
     } else {
-        config
+        GpuConfig { dispatch: config.dispatch.for_method(method), ..config }
     }
 }
 

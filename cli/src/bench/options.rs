@@ -130,8 +130,8 @@ pub struct BenchArgs {
     /// comma-separated for a parameter study [default: 0.004]
     #[arg(long, value_name = "F[,F...]")]
     pub stream_cell: Option<String>,
-    /// GPU dispatch: grid, persistent or persistent:<workgroups>, comma-separated for a sweep
-    /// [default: grid]
+    /// GPU dispatch: auto (persistent threads for the wide stack methods, a grid for the rest),
+    /// grid, persistent or persistent:<workgroups>, comma-separated for a sweep [default: auto]
     #[arg(long, value_name = "D[,D...]")]
     pub gpu_dispatch: Option<String>,
     /// GPU workgroup size, comma-separated for a sweep [default: 64]
