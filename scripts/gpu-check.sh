@@ -1,18 +1,20 @@
 #!/usr/bin/env bash
 # The GPU checks of a session with a lent GPU machine, prepared here and run there in one call.
 #
-#   scripts/gpu-check.sh prepare    # here: build, strip and gather into dev-carry/ (about 55 MB)
+#   scripts/gpu-check.sh prepare    # here: build, strip and gather into dev-carry/ (about 53 MB)
 #   scripts/gpu-check.sh run [quick] [kitchen,dragon,sponza]
-#                                   # there: the wgpu conformance suite on the GPU, then the bench
+#                                   # there: the wgpu conformance suites on the GPU, then the bench
 #
-# `prepare` builds the CLI and the wgpu conformance test in release mode, strips both into
-# dev-carry/ and copies the scenes there (from $RAYTRAIL_SCENES, else ../shared/scenes). The
-# machine there has no Vulkan loader: put its Debian packages in .gl/ (libvulkan1 and the
-# libglvnd set); `run` unpacks them. Carry `.gl` and `dev-carry` with the call.
+# `prepare` builds the CLI and the two wgpu conformance suites (on the grid, and on persistent
+# threads) in release mode, strips them into dev-carry/ and copies the scenes there (from
+# $RAYTRAIL_SCENES, else ../shared/scenes). The machine there has no Vulkan loader: put its
+# Debian packages in .gl/ (libvulkan1 and the libglvnd set); `run` unpacks them. Carry `.gl` and
+# `dev-carry` with the call (with the repository, under the device tool's 64 MiB).
 #
-# `run` writes conformance.log and, per scene, SCENE.txt and SCENE.json under $OUT (else
-# /tmp/gpu-out). `quick` shrinks everything for a dry run on lavapipe. SKIP_CONF=1 skips the suite.
-# On an H100 the whole run took about 4 minutes (BENCHMARKS.md, "On an NVIDIA H100 (2026-11-27)").
+# `run` writes each suite's log and, per scene, SCENE.txt and SCENE.json under $OUT (else
+# /tmp/gpu-out). `quick` shrinks everything for a dry run on lavapipe; SKIP_CONF=1 skips the
+# suites. On an H100 the suite and the three scenes took about 4 minutes (BENCHMARKS.md, "On an
+# NVIDIA H100 (2026-11-27)"); the persistent-threads suite has not run there yet.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 carry=$root/dev-carry
@@ -21,12 +23,14 @@ prepare)
     set -e
     cd "$root"
     cargo build --release -p raytrail-cli
-    test=$(cargo test --release -p raytrail-wgpu --test conformance --no-run --message-format=json 2>/dev/null |
-        sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -1)
-    [ -n "$test" ] || { echo "no conformance test binary was built" >&2; exit 1; }
     mkdir -p "$carry/scenes"
     strip -o "$carry/raytrail" target/release/raytrail
-    strip -o "$carry/conformance" "$test"
+    for suite in conformance conformance_persistent; do
+        test=$(cargo test --release -p raytrail-wgpu --test $suite --no-run --message-format=json 2>/dev/null |
+            sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -1)
+        [ -n "$test" ] || { echo "the $suite test binary was not built" >&2; exit 1; }
+        strip -o "$carry/$suite" "$test"
+    done
     scenes=${RAYTRAIL_SCENES:-$root/../shared/scenes}
     cp "$scenes"/* "$carry/scenes/" && chmod -R u+w "$carry/scenes"
     du -sh "$carry"
@@ -44,12 +48,14 @@ run)
     nvidia-smi --query-gpu=name,clocks.sm,clocks.max.sm,temperature.gpu --format=csv 2>/dev/null
     if [ -n "$quick" ]; then size="-W 64 -H 48"; warm=0.05; passes=1; threads=2
     else size="-W 1920 -H 1080"; warm=0.3; passes=5; threads=16; fi
-    if [ -z "${SKIP_CONF:-}" ]; then
-        echo "== conformance $(date +%T)"
-        RAYTRAIL_REQUIRE_GPU=1 timeout 200 "$carry/conformance" --test-threads 4 >"$out/conformance.log" 2>&1
-        echo "conformance rc=$?"
-        grep -E "test result|FAILED|panicked" "$out/conformance.log" | tail -20
-    fi
+    # The grid suite, then every method on persistent threads (together: both dispatches).
+    for suite in conformance conformance_persistent; do
+        [ -n "${SKIP_CONF:-}" ] && break
+        echo "== $suite $(date +%T)"
+        RAYTRAIL_REQUIRE_GPU=1 timeout 200 "$carry/$suite" --test-threads 4 >"$out/$suite.log" 2>&1
+        echo "$suite rc=$?"
+        grep -E "test result|FAILED|panicked" "$out/$suite.log" | tail -20
+    done
     cd "$carry/scenes"
     for name in ${scenes//,/ }; do
         case $name in
@@ -69,7 +75,7 @@ run)
     done
     ;;
 *)
-    sed -n 2,15p "$0"
+    sed -n 2,17p "$0"
     exit 2
     ;;
 esac
