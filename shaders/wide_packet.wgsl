@@ -9,10 +9,14 @@
 //   order for any hit), visits the first and pushes the others with their masks and keys;
 // - at a leaf, every ray of the mask tests its triangles; an any-hit ray that finds one leaves;
 // - a popped entry keeps its rays still in the packet (each records a stack pop) whose interval
-//   reaches the key, checked by the rays themselves in a step of their own.
+//   reaches the key, checked by the rays themselves in a step of their own;
+// - a child to be visited by at most WIDE_HAND_OVER rays is handed over: each of them traverses
+//   its subtree alone with `wide_stack.wgsl`'s single-ray loop (a step of its own), then the
+//   packet pops its next entry.
 // Each step is one turn of a loop that the whole workgroup runs together (its exit is read with
 // `workgroupUniformLoad`), so the barriers stay in uniform control flow. Built on `wide.wgsl`
-// (WT_T, WT_SLOT, wide_test, wide_order, wide_push, wide_slot, wide_leaf, wide_ref).
+// (WT_T, WT_SLOT, wide_test, wide_order, wide_push, wide_slot, wide_leaf, wide_ref) and
+// `wide_stack.wgsl` (WS_CURRENT, WS_HAS_CURRENT, WS_LEN, wide_step).
 
 // The dispatch override every kernel declares; the workgroup is a packet here.
 override WORKGROUP_SIZE: u32 = 64u;
@@ -23,6 +27,8 @@ const WP_KEY_NONE: u32 = 0xff800000u;
 // What the current step does: visit WP_CUR, or check which rays of a popped entry reach it.
 const WP_VISIT: u32 = 1u;
 const WP_CHECK: u32 = 2u;
+// Or hand WP_CUR over to its rays.
+const WP_ALONE: u32 = 3u;
 
 // A child with its rays and key (the current one, or a postponed one).
 struct WpEntry {
@@ -71,6 +77,25 @@ fn wp_lane(lane: u32) {
         }
         return;
     }
+    if WP_PHASE == WP_ALONE {
+        // `WideState::run` from the handed-over child, as `wide_stack.wgsl`'s `trace` runs.
+        WS_CURRENT = WideChild(cur.child, cur.count);
+        WS_HAS_CURRENT = true;
+        WS_LEN = 0u;
+        var budget = P.max_steps;
+        loop {
+            if wide_step() == STEP_DONE || budget == 0u {
+                break;
+            }
+            budget = budget - 1u;
+        }
+        if q_is_answered() {
+            atomicAnd(&WP_ACTIVE, ~bit);
+        } else {
+            WP_T_HI[lane] = box_interval(q_limit()).y;
+        }
+        return;
+    }
     rec_node(wide_ref(WideChild(cur.child, cur.count)));
     if cur.count != 0u {
         wide_leaf(cur.child, cur.count);
@@ -99,7 +124,12 @@ fn wp_enter(c: WideChild, rays: u32, key: f32) {
     }
     WP_BUDGET = WP_BUDGET - 1u;
     WP_CUR = WpEntry(c.child, c.count, rays, key);
-    WP_PHASE = WP_VISIT;
+    WP_PHASE = wp_visit_phase(rays);
+}
+
+// Visited by the packet, or handed over to its rays when they are few.
+fn wp_visit_phase(rays: u32) -> u32 {
+    return select(WP_VISIT, WP_ALONE, countOneBits(rays) <= WIDE_HAND_OVER);
 }
 
 // The next postponed entry with rays still in the packet, to be checked; none ends the packet.
@@ -124,6 +154,10 @@ fn wp_pop() {
 // The leading invocation's part of a step: what comes next.
 fn wp_lead() {
     let cur = WP_CUR;
+    if WP_PHASE == WP_ALONE {
+        wp_pop();
+        return;
+    }
     if WP_PHASE == WP_CHECK {
         let live = atomicLoad(&WP_LIVE);
         atomicStore(&WP_LIVE, 0u);
@@ -216,6 +250,7 @@ fn main(
         } else {
             WP_CUR = WpEntry(P.root, 0u, in_packet, 0.0);
         }
+        WP_PHASE = wp_visit_phase(in_packet);
         WP_GO = select(0u, 1u, in_packet != 0u);
     }
     loop {

@@ -155,7 +155,8 @@ impl Variant {
                 &[KD_COMMON, KD_RESTART]
             }
             Method::Kd(KdMethod::Packet) => &[KD_COMMON, KD_PACKET],
-            Method::Wide(m) if m.packets() => &[WIDE, WIDE_PACKET],
+            // The single-ray loop too: a packet hands thin subtrees to its rays.
+            Method::Wide(m) if m.packets() => &[WIDE, WIDE_STACK, WIDE_PACKET],
             Method::Wide(m) if m.keyed() => &[WIDE, keys, HASH, WIDE_TRAIL],
             Method::Wide(_) => &[WIDE, WIDE_STACK],
             // Its stages are kernels of their own (crate::stream); this is the one that traces.
@@ -229,6 +230,7 @@ pub(crate) fn constants_header(method: Method) -> String {
          const SHORT_STACK_MAX: u32 = {SHORT_STACK_MAX}u;\n\
          const PACKET_WIDTH: u32 = {PACKET_WIDTH}u;\n\
          const WIDE_PACKET: u32 = {wide_packet}u;\n\
+         const WIDE_HAND_OVER: u32 = {hand_over}u;\n\
          // Children per wide node, and the node keys' bits per level (its log2).\n\
          const WIDE_W: u32 = {wide_width}u;\n\
          const WK_BITS: u32 = {wide_bits}u;\n",
@@ -237,6 +239,7 @@ pub(crate) fn constants_header(method: Method) -> String {
         RELIABLE_LIMIT.to_bits(),
         REFINE_SCALE.to_bits(),
         wide_packet = raytrail_core::wide::packet::WIDE_PACKET,
+        hand_over = raytrail_core::wide::packet::HAND_OVER,
         wide_bits = wide_width.trailing_zeros(),
     )
 }

@@ -95,9 +95,9 @@ impl WideMethod {
     /// Per-ray state in bytes for a wide tree of `depth` levels: node address, current entry
     /// distance, stack pointer, and `width - 1` entries of (node, entry distance) per level. A
     /// packet's node, mask and stack (entries of node, ray mask and key) are shared by its
-    /// [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET) rays; each ray adds its box interval. The
-    /// keyed method keeps the node address, its key, its trail and a register (a parent node),
-    /// whatever the depth.
+    /// [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET) rays; each ray adds its box interval, and
+    /// the single-ray state it needs when the packet hands it a subtree. The keyed method keeps
+    /// the node address, its key, its trail and a register (a parent node), whatever the depth.
     pub fn state_bytes(self, depth: u32) -> usize {
         if self.keyed() {
             let key = match crate::wide::keyed::wide_key_width::<4>(depth) {
@@ -108,10 +108,15 @@ impl WideMethod {
         } else if self.packets() {
             let rays = crate::wide::packet::WIDE_PACKET;
             let shared = 8 + 8 + 4 + 16 * (self.width() - 1) * depth as usize;
-            8 + shared.div_ceil(rays)
+            8 + shared.div_ceil(rays) + self.single_ray_bytes(depth)
         } else {
-            4 + 4 + 4 + 8 * (self.width() - 1) * depth as usize
+            self.single_ray_bytes(depth)
         }
+    }
+
+    /// A stack traversal's state for one ray over `depth` levels.
+    fn single_ray_bytes(self, depth: u32) -> usize {
+        4 + 4 + 4 + 8 * (self.width() - 1) * depth as usize
     }
 }
 

@@ -14,6 +14,11 @@
 //! - A popped entry keeps the rays of its mask still in the packet, each recording a stack pop,
 //!   and of those the rays whose box interval still reaches the key (a ray's own entry distance
 //!   is no less than the key, so a ray dropped here would have dropped the child alone too).
+//! - **Hand-over:** a child about to be visited (the root, a first child, or a popped entry) by
+//!   at most [`HAND_OVER`] rays is not visited by the packet. Each of those rays, in lane order,
+//!   traverses the child's subtree alone, as the single-ray method does from that child (its own
+//!   order, its own stack, the step budget afresh), recording its own events; an any-hit ray
+//!   answered there leaves the packet. The packet then pops its next entry.
 //!
 //! Closest hits are the single-ray method's bit for bit: every ray still tests every leaf whose
 //! box it enters before its closest hit, and ties go to the smaller primitive id whatever the
@@ -25,7 +30,7 @@
 use super::kernel::{ChildHits, ChildKernel, ReferenceKernel};
 use super::memory::WideMemory;
 use super::node::{WideChild, WideNode};
-use super::traverse::{leaf, visiting_order, WideRayContext, WideRoot, WIDE_STACK};
+use super::traverse::{leaf, visiting_order, WideRayContext, WideRoot, WideState, WIDE_STACK};
 use crate::intersect::{NoPair, SlabRay, TriangleTest};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
@@ -38,6 +43,14 @@ use core::mem::MaybeUninit;
 /// against single rays on coherent rays (the prototype's 8 to 64 rays: BENCHMARKS.md, "Single-ray
 /// changes that did not pay, and packets that might").
 pub const WIDE_PACKET: usize = 32;
+
+/// Rays at or below which a packet hands a child over to its rays (see the module docs). A box
+/// test of a node for a packet costs about as much for one ray as for eight (a register of rays
+/// per child), where one ray alone tests all its children at once; in the in-process A/B against
+/// the packet without hand-over, 8 beat 2 and 4 on the kitchen's diffuse rays (1.27x against 1.16x
+/// and 1.22x) and gained 1.1-1.5x on Sponza's and the dragon's camera, diffuse and ambient-occlusion
+/// rays (BENCHMARKS.md, "The packet hands thin subtrees to its rays").
+pub const HAND_OVER: u32 = 8;
 
 /// The rays of a packet as the box tests read them: per ray (lane), the slab constants and the
 /// interval a box is tested over, with bounds over the packet that a vector test may cull by.
@@ -204,7 +217,35 @@ pub fn trace_wide_packet<
     let mut len = 0usize;
     let mut current = (active != 0).then_some((root.root, active));
     let mut budget = root.max_steps;
+    // The single-ray state of the rays handed over (its stack storage is left uninitialized).
+    let mut single = WideState::<W>::new(root.root);
     while let Some((child, mask)) = current {
+        if mask.count_ones() <= HAND_OVER {
+            let mut m = mask;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let Some((c, q)) = ctx[i].as_mut() else { continue };
+                single.run::<M, T, K, O>(mem, WideRoot { root: child, ..root }, c, q, &mut obs[i]);
+                if q.is_answered() {
+                    active &= !(1 << i);
+                } else {
+                    p.t_hi[i] = c.box_interval(q.limit()).1;
+                }
+            }
+            if !query.is_any() {
+                p.t_hi_max = p.t_hi.iter().fold(f32::NEG_INFINITY, |m, &t| m.max(t));
+            }
+            let next = pop::<N, P, O>(&stack, &mut len, &p, active, obs);
+            current = match next {
+                Some(c) if budget > 0 && active != 0 => {
+                    budget -= 1;
+                    Some(c)
+                }
+                _ => None,
+            };
+            continue;
+        }
         if O::ENABLED {
             for_each_ray(mask, |i| obs[i].node(child.node_ref()));
         }
