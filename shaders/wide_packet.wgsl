@@ -16,7 +16,7 @@
 // Each step is one turn of a loop that the whole workgroup runs together (its exit is read with
 // `workgroupUniformLoad`), so the barriers stay in uniform control flow. Built on `wide.wgsl`
 // (WT_T, WT_SLOT, wide_test, wide_order, wide_push, wide_slot, wide_leaf, wide_ref) and
-// `wide_stack.wgsl` (WS_CURRENT, WS_HAS_CURRENT, WS_LEN, wide_step).
+// `wide_stack.wgsl` (wide_run).
 
 // The dispatch override every kernel declares; the workgroup is a packet here.
 override WORKGROUP_SIZE: u32 = 64u;
@@ -78,17 +78,7 @@ fn wp_lane(lane: u32) {
         return;
     }
     if WP_PHASE == WP_ALONE {
-        // `WideState::run` from the handed-over child, as `wide_stack.wgsl`'s `trace` runs.
-        WS_CURRENT = WideChild(cur.child, cur.count);
-        WS_HAS_CURRENT = true;
-        WS_LEN = 0u;
-        var budget = P.max_steps;
-        loop {
-            if wide_step() == STEP_DONE || budget == 0u {
-                break;
-            }
-            budget = budget - 1u;
-        }
+        wide_run(WideChild(cur.child, cur.count));
         if q_is_answered() {
             atomicAnd(&WP_ACTIVE, ~bit);
         } else {

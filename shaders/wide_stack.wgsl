@@ -84,12 +84,9 @@ fn wide_step() -> u32 {
     return STEP_CONTINUE;
 }
 
-// `trace_wide_batch`'s drive loop: the step always runs once, then the budget is checked.
-fn trace(r: Ray) -> Hit {
-    if !begin(r) {
-        return miss();
-    }
-    WS_CURRENT = wide_root();
+// `WideState::run` from `c`: the step always runs once, then the budget is checked.
+fn wide_run(c: WideChild) {
+    WS_CURRENT = c;
     WS_HAS_CURRENT = true;
     WS_LEN = 0u;
     var budget = P.max_steps;
@@ -99,5 +96,13 @@ fn trace(r: Ray) -> Hit {
         }
         budget = budget - 1u;
     }
+}
+
+// `trace_wide_batch`'s drive loop.
+fn trace(r: Ray) -> Hit {
+    if !begin(r) {
+        return miss();
+    }
+    wide_run(wide_root());
     return Q_HIT;
 }

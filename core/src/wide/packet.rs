@@ -220,36 +220,18 @@ pub fn trace_wide_packet<
     // The single-ray state of the rays handed over (its stack storage is left uninitialized).
     let mut single = WideState::<W>::new(root.root);
     while let Some((child, mask)) = current {
-        if mask.count_ones() <= HAND_OVER {
-            let mut m = mask;
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let Some((c, q)) = ctx[i].as_mut() else { continue };
-                single.run::<M, T, K, O>(mem, WideRoot { root: child, ..root }, c, q, &mut obs[i]);
-                if q.is_answered() {
-                    active &= !(1 << i);
-                } else {
-                    p.t_hi[i] = c.box_interval(q.limit()).1;
-                }
-            }
-            if !query.is_any() {
-                p.t_hi_max = p.t_hi.iter().fold(f32::NEG_INFINITY, |m, &t| m.max(t));
-            }
-            let next = pop::<N, P, O>(&stack, &mut len, &p, active, obs);
-            current = match next {
-                Some(c) if budget > 0 && active != 0 => {
-                    budget -= 1;
-                    Some(c)
-                }
-                _ => None,
-            };
-            continue;
-        }
-        if O::ENABLED {
+        let hand_over = mask.count_ones() <= HAND_OVER;
+        if O::ENABLED && !hand_over {
             for_each_ray(mask, |i| obs[i].node(child.node_ref()));
         }
         let next = match child {
+            _ if hand_over => {
+                let sub = WideRoot { root: child, ..root };
+                each_alone(mask, &mut ctx, &mut p, &mut active, query, obs, |c, q, o| {
+                    single.run::<M, T, K, O>(mem, sub, c, q, o)
+                });
+                pop::<N, P, O>(&stack, &mut len, &p, active, obs)
+            }
             WideChild::Node(index) => {
                 let node = mem.wide_node(index);
                 let h = P::test::<W, N>(&node, &p, mask);
@@ -274,24 +256,9 @@ pub fn trace_wide_packet<
                 }
             }
             WideChild::Leaf { first, count } => {
-                let mut m = mask;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let Some((c, q)) = ctx[i].as_mut() else { continue };
-                    leaf::<W, M, T, K, O>(mem, first, count, c, q, &mut obs[i]);
-                    if q.is_answered() {
-                        active &= !(1 << i);
-                    } else {
-                        p.t_hi[i] = c.box_interval(q.limit()).1;
-                    }
-                }
-                // Lanes without a ray hold `-inf`, and closest-hit rays never leave the packet; an
-                // any-hit ray's interval never shrinks, so the bound stays one (if looser) as its
-                // rays leave.
-                if !query.is_any() {
-                    p.t_hi_max = p.t_hi.iter().fold(f32::NEG_INFINITY, |m, &t| m.max(t));
-                }
+                each_alone(mask, &mut ctx, &mut p, &mut active, query, obs, |c, q, o| {
+                    leaf::<W, M, T, K, O>(mem, first, count, c, q, o);
+                });
                 pop::<N, P, O>(&stack, &mut len, &p, active, obs)
             }
         };
@@ -307,6 +274,38 @@ pub fn trace_wide_packet<
         if let Some((_, q)) = &ctx[i] {
             hits[i] = q.hit;
         }
+    }
+}
+
+/// Lets each ray of `mask`, in order, do `f` on its own (test a leaf, or walk a handed-over
+/// subtree), then takes an answered ray out of the packet and narrows the others' box intervals
+/// to their closest hits.
+#[inline(always)]
+fn each_alone<T: TriangleTest, O: Observer, const N: usize>(
+    mask: u64,
+    ctx: &mut [Option<(WideRayContext<T>, QueryState)>; N],
+    p: &mut PacketRays<N>,
+    active: &mut u64,
+    query: Query,
+    obs: &mut [O],
+    mut f: impl FnMut(&WideRayContext<T>, &mut QueryState, &mut O),
+) {
+    let mut m = mask;
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let Some((c, q)) = ctx[i].as_mut() else { continue };
+        f(c, q, &mut obs[i]);
+        if q.is_answered() {
+            *active &= !(1 << i);
+        } else {
+            p.t_hi[i] = c.box_interval(q.limit()).1;
+        }
+    }
+    // Lanes without a ray hold `-inf`, and closest-hit rays never leave the packet; an any-hit
+    // ray's interval never shrinks, so the bound stays one (if looser) as its rays leave.
+    if !query.is_any() {
+        p.t_hi_max = p.t_hi.iter().fold(f32::NEG_INFINITY, |m, &t| m.max(t));
     }
 }
 
