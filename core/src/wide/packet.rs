@@ -47,7 +47,7 @@ pub const WIDE_PACKET: usize = 32;
 /// Rays at or below which a packet hands a child over to its rays (see the module docs). A box
 /// test of a node for a packet costs about as much for one ray as for eight (a register of rays
 /// per child), where one ray alone tests all its children at once; in the in-process A/B against
-/// the packet without hand-over, 8 beat 2 and 4 on the kitchen's diffuse rays (1.27x against 1.16x
+/// the packet without hand-over, 8 beat 2 and 4 on the kitchen's diffuse rays (1.27x against 1.15x
 /// and 1.22x) and gained 1.1-1.5x on Sponza's and the dragon's camera, diffuse and ambient-occlusion
 /// rays (BENCHMARKS.md, "The packet hands thin subtrees to its rays").
 pub const HAND_OVER: u32 = 8;
