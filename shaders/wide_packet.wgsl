@@ -63,6 +63,16 @@ fn wp_unordered(k: u32) -> f32 {
     return bitcast<f32>(select(~k, k & 0x7fffffffu, (k & 0x80000000u) != 0u));
 }
 
+// After a ray's leaf test or handed-over subtree (`each_alone`): an answered ray leaves the
+// packet, the others narrow their box interval to their closest hit.
+fn wp_after_alone(lane: u32) {
+    if q_is_answered() {
+        atomicAnd(&WP_ACTIVE, ~(1u << lane));
+    } else {
+        WP_T_HI[lane] = box_interval(q_limit()).y;
+    }
+}
+
 // One ray's part of a step.
 fn wp_lane(lane: u32) {
     let cur = WP_CUR;
@@ -79,21 +89,13 @@ fn wp_lane(lane: u32) {
     }
     if WP_PHASE == WP_ALONE {
         wide_run(WideChild(cur.child, cur.count));
-        if q_is_answered() {
-            atomicAnd(&WP_ACTIVE, ~bit);
-        } else {
-            WP_T_HI[lane] = box_interval(q_limit()).y;
-        }
+        wp_after_alone(lane);
         return;
     }
     rec_node(wide_ref(WideChild(cur.child, cur.count)));
     if cur.count != 0u {
         wide_leaf(cur.child, cur.count);
-        if q_is_answered() {
-            atomicAnd(&WP_ACTIVE, ~bit);
-        } else {
-            WP_T_HI[lane] = box_interval(q_limit()).y;
-        }
+        wp_after_alone(lane);
         return;
     }
     let iv = box_interval(q_limit());

@@ -62,8 +62,8 @@ fn persistent_rounds(gpu: &Gpu) -> usize {
 pub(crate) fn grid(gpu: &Gpu, launch: &Launch<'_>, items: usize) -> Result<Dispatched, Error> {
     let wg = launch.config.workgroup_size as usize;
     let rounds = persistent_rounds(gpu);
-    // The launch's dispatch is resolved for its method already; resolving is idempotent.
-    let groups = match launch.config.dispatch.for_method(launch.method) {
+    // `launch` resolved the dispatch for its method (`Dispatch::for_method`): never `ByMethod` here.
+    let groups = match launch.config.dispatch {
         Dispatch::Grid | Dispatch::ByMethod => items.div_ceil(wg),
         Dispatch::Persistent { workgroups } => {
             (workgroups as usize).max(items.div_ceil(wg * rounds)).min(items.div_ceil(wg))
@@ -146,7 +146,7 @@ pub(crate) fn encode(
     dims: (u32, u32),
     stamps: Stamps<'_>,
 ) {
-    if let Dispatch::Persistent { .. } = launch.config.dispatch.for_method(launch.method) {
+    if let Dispatch::Persistent { .. } = launch.config.dispatch {
         enc.clear_buffer(&slot.counter, 0, None);
     }
     let bind = slot.bind_group(gpu, launch.bind_layout, launch.method, &launch.scene).clone();
