@@ -1,20 +1,25 @@
 #!/usr/bin/env bash
 # The GPU checks of a session with a lent GPU machine, prepared here and run there in one call.
 #
-#   scripts/gpu-check.sh prepare    # here: build, strip and gather into dev-carry/ (about 53 MB)
+#   [AB_OLD=REV] scripts/gpu-check.sh prepare
+#                                   # here: build, strip, gzip and gather into dev-carry/ (~40 MB)
 #   scripts/gpu-check.sh run [quick] [kitchen,dragon,sponza]
 #                                   # there: the wgpu conformance suites on the GPU, then the bench
 #
-# `prepare` builds the CLI and the two wgpu conformance suites (on the grid, and on persistent
-# threads) in release mode, strips them into dev-carry/ and copies the scenes there (from
-# $RAYTRAIL_SCENES, else ../shared/scenes). The machine there has no Vulkan loader: put its
-# Debian packages in .gl/ (libvulkan1 and the libglvnd set); `run` unpacks them. Carry `.gl` and
-# `dev-carry` with the call (with the repository, under the device tool's 64 MiB).
+# `prepare` builds the working tree's CLI and its two wgpu conformance suites (on the grid, and on
+# persistent threads) in release mode, strips and gzips them into dev-carry/ and copies the scenes
+# there (from $RAYTRAIL_SCENES, else ../shared/scenes). With AB_OLD=REV it also builds the CLI of
+# commit REV (in a temporary worktree), and `run` then benches both binaries on each scene, the old
+# one first, so that a GPU change is timed side by side with what it replaces. The machine there
+# has no Vulkan loader: put its Debian packages in .gl/ (libvulkan1 and the libglvnd set); `run`
+# unpacks them. Carry `.gl` and `dev-carry` with the call (with the repository, under the device
+# tool's 64 MiB).
 #
-# `run` writes each suite's log and, per scene, SCENE.txt and SCENE.json under $OUT (else
-# /tmp/gpu-out). `quick` shrinks everything for a dry run on lavapipe; SKIP_CONF=1 skips the
-# suites. On an H100 the suite and the three scenes took about 4 minutes (BENCHMARKS.md, "On an
-# NVIDIA H100 (2026-11-27)"); the persistent-threads suite has not run there yet.
+# `run` writes each suite's log and, per scene, SCENE.txt and SCENE.json (SCENE-old.* for the old
+# binary) under $OUT (else /tmp/gpu-out). `quick` shrinks everything for a dry run on lavapipe;
+# SKIP_CONF=1 skips the suites; METHODS=a,b,... replaces the bench's methods. On an H100 the grid
+# suite and the three scenes took about 4 minutes (BENCHMARKS.md, "On an NVIDIA H100
+# (2026-11-27)").
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 carry=$root/dev-carry
@@ -23,7 +28,7 @@ prepare)
     set -e
     cd "$root"
     cargo build --release -p raytrail-cli
-    mkdir -p "$carry/scenes"
+    rm -rf "$carry" && mkdir -p "$carry/scenes"
     strip -o "$carry/raytrail" target/release/raytrail
     for suite in conformance conformance_persistent; do
         test=$(cargo test --release -p raytrail-wgpu --test $suite --no-run --message-format=json 2>/dev/null |
@@ -33,6 +38,14 @@ prepare)
     done
     scenes=${RAYTRAIL_SCENES:-$root/../shared/scenes}
     cp "$scenes"/* "$carry/scenes/" && chmod -R u+w "$carry/scenes"
+    if [ -n "${AB_OLD:-}" ]; then
+        old=$(mktemp -d /tmp/raytrail-gpu-old.XXXXXX)
+        git worktree add --quiet --detach "$old" "$AB_OLD"
+        (cd "$old" && CARGO_TARGET_DIR=$root/target/ab-old cargo build --release -p raytrail-cli)
+        git worktree remove --force "$old"
+        strip -o "$carry/raytrail-old" target/ab-old/release/raytrail
+    fi
+    gzip -9 "$carry"/raytrail* "$carry"/conformance*
     du -sh "$carry"
     ;;
 run)
@@ -40,6 +53,7 @@ run)
     for a in "${@:2}"; do if [ "$a" = quick ]; then quick=1; else scenes=$a; fi; done
     out=${OUT:-/tmp/gpu-out}; mkdir -p "$out"
     cd "$root"
+    for z in "$carry"/*.gz; do [ -e "$z" ] && gzip -dkf "$z" && chmod +x "${z%.gz}"; done
     if [ -z "$quick" ] && [ -d .gl ]; then
         for f in .gl/*.deb; do dpkg -x "$f" /; done
         ldconfig
@@ -65,17 +79,21 @@ run)
         *) file=$name; rays=primary,ao ;;
         esac
         [ -n "$quick" ] && file=builtin
-        echo "== bench $name $(date +%T)"
-        timeout 150 "$carry/raytrail" bench --scene "$file" --view inside --rays "$rays" \
-            --methods stack,bvh4,bvh4-hash,bvh8,bvh8-packet --peers none $size --ao-rays 1 \
-            --passes $passes --gpu-warm-up $warm --threads $threads --gpu-dispatch grid,persistent \
-            --gpu-workgroup 64 --json "$out/$name.json" >"$out/$name.txt" 2>&1
-        echo "rc=$?"
-        grep -E "^  gpu:" "$out/$name.txt" | tail -12
+        sides=""; [ -x "$carry/raytrail-old" ] && sides="-old"
+        for side in $sides ""; do
+            echo "== bench $name$side $(date +%T)"
+            timeout 150 "$carry/raytrail$side" bench --scene "$file" --view inside --rays "$rays" \
+                --methods "${METHODS:-stack,bvh4,bvh4-hash,bvh8,bvh8-packet}" --peers none $size \
+                --ao-rays 1 --passes $passes --gpu-warm-up $warm --threads $threads \
+                --gpu-dispatch grid,persistent --gpu-workgroup 64 --json "$out/$name$side.json" \
+                >"$out/$name$side.txt" 2>&1
+            echo "rc=$?"
+            grep -E "^  gpu:" "$out/$name$side.txt" | tail -12
+        done
     done
     ;;
 *)
-    sed -n 2,17p "$0"
+    sed -n 2,21p "$0"
     exit 2
     ;;
 esac
