@@ -53,7 +53,13 @@ run)
     for a in "${@:2}"; do if [ "$a" = quick ]; then quick=1; else scenes=$a; fi; done
     out=${OUT:-/tmp/gpu-out}; mkdir -p "$out"
     cd "$root"
-    for z in "$carry"/*.gz; do [ -e "$z" ] && gzip -dkf "$z" && chmod +x "${z%.gz}"; done
+    # Unpacked outside dev-carry, which must stay small enough to carry.
+    bin=$(mktemp -d /tmp/raytrail-gpu-bin.XXXXXX)
+    for z in "$carry"/*.gz; do
+        [ -e "$z" ] || continue
+        b=$bin/$(basename "${z%.gz}")
+        gzip -dc "$z" >"$b" && chmod +x "$b"
+    done
     if [ -z "$quick" ] && [ -d .gl ]; then
         for f in .gl/*.deb; do dpkg -x "$f" /; done
         ldconfig
@@ -66,7 +72,7 @@ run)
     for suite in conformance conformance_persistent; do
         [ -n "${SKIP_CONF:-}" ] && break
         echo "== $suite $(date +%T)"
-        RAYTRAIL_REQUIRE_GPU=1 timeout 200 "$carry/$suite" --test-threads 4 >"$out/$suite.log" 2>&1
+        RAYTRAIL_REQUIRE_GPU=1 timeout 200 "$bin/$suite" --test-threads 4 >"$out/$suite.log" 2>&1
         echo "$suite rc=$?"
         grep -E "test result|FAILED|panicked" "$out/$suite.log" | tail -20
     done
@@ -79,10 +85,10 @@ run)
         *) file=$name; rays=primary,ao ;;
         esac
         [ -n "$quick" ] && file=builtin
-        sides=""; [ -x "$carry/raytrail-old" ] && sides="-old"
+        sides=""; [ -x "$bin/raytrail-old" ] && sides="-old"
         for side in $sides ""; do
             echo "== bench $name$side $(date +%T)"
-            timeout 150 "$carry/raytrail$side" bench --scene "$file" --view inside --rays "$rays" \
+            timeout 150 "$bin/raytrail$side" bench --scene "$file" --view inside --rays "$rays" \
                 --methods "${METHODS:-stack,bvh4,bvh4-hash,bvh8,bvh8-packet}" --peers none $size \
                 --ao-rays 1 --passes $passes --gpu-warm-up $warm --threads $threads \
                 --gpu-dispatch grid,persistent --gpu-workgroup 64 --json "$out/$name$side.json" \
