@@ -40,9 +40,9 @@ prepare)
     cp "$scenes"/* "$carry/scenes/" && chmod -R u+w "$carry/scenes"
     if [ -n "${AB_OLD:-}" ]; then
         old=$(mktemp -d /tmp/raytrail-gpu-old.XXXXXX)
+        trap 'git -C "$root" worktree remove --force "$old" >/dev/null 2>&1 || true' EXIT
         git worktree add --quiet --detach "$old" "$AB_OLD"
         (cd "$old" && CARGO_TARGET_DIR=$root/target/ab-old cargo build --release -p raytrail-cli)
-        git worktree remove --force "$old"
         strip -o "$carry/raytrail-old" target/ab-old/release/raytrail
     fi
     gzip -9 "$carry"/raytrail* "$carry"/conformance*

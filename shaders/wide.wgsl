@@ -40,10 +40,20 @@ struct WideSlot {
     c: WideChild,
 }
 
+// Where slot `i`'s child lies in `kd` (its count lies WIDE_W words on): a 4-byte handle for the
+// child that a stack entry can hold in place of child and count.
+fn wide_child_word(node: u32, i: u32) -> u32 {
+    return node * 8u * WIDE_W + 6u * WIDE_W + i;
+}
+
+// The child whose word is `word` (`wide_child_word`).
+fn wide_child_at(word: u32) -> WideChild {
+    return WideChild(kd[word], kd[word + WIDE_W]);
+}
+
 fn wide_slot(node: u32, i: u32) -> WideSlot {
-    let child = wide_word(node, 6u * WIDE_W + i);
-    let count = wide_word(node, 7u * WIDE_W + i);
-    return WideSlot(child != WIDE_EMPTY && i < WIDE_W, WideChild(child, count));
+    let c = wide_child_at(wide_child_word(node, i));
+    return WideSlot(c.child != WIDE_EMPTY && i < WIDE_W, c);
 }
 
 // `ChildKernel::test`: each child box by the slab test over the widened interval. WT_T and WT_SLOT

@@ -11,10 +11,10 @@
 // than half of it; a tree never fills either, so both push exactly the CPU's entries.
 const WIDE_STACK: u32 = (WIDE_W - 1u) * 64u;
 
-// An entry is 8 bytes: the word of the postponed slot's child in the node memory (its count lies
-// WIDE_W words on) and its entry distance. The pop reads the child back from the node; the stack,
-// in local memory, moves two thirds of the bytes of an entry holding child and count. On an H200
-// that made every wide stack kernel 1.01-1.45x faster (BENCHMARKS.md, "8-byte stack entries").
+// An entry is 8 bytes: where the postponed child lies in the node memory (`wide_child_word`) and
+// its entry distance. The pop reads the child back from the node; the stack, in local memory,
+// moves two thirds of the bytes of an entry holding child and count. On an H200 that made every
+// wide stack kernel 1.01-1.45x faster (BENCHMARKS.md, "8-byte stack entries").
 struct WideEntry {
     word: u32,
     t_enter: f32,
@@ -37,7 +37,7 @@ fn wide_pop() -> u32 {
         if e.t_enter > q_limit() + C.t_slack {
             continue;
         }
-        WS_CURRENT = WideChild(kd[e.word], kd[e.word + WIDE_W]);
+        WS_CURRENT = wide_child_at(e.word);
         return STEP_CONTINUE;
     }
     WS_HAS_CURRENT = false;
@@ -74,7 +74,7 @@ fn wide_step() -> u32 {
         let p = wide_push(k, mask, first_slot, n);
         let slot = p.slot;
         if p.push && WS_LEN < WIDE_STACK {
-            let word = cur.child * 8u * WIDE_W + 6u * WIDE_W + slot;
+            let word = wide_child_word(cur.child, slot);
             if slot < WIDE_W && kd[word] != WIDE_EMPTY {
                 WS_STACK[WS_LEN] = WideEntry(word, WT_T[k]);
                 WS_LEN = WS_LEN + 1u;
