@@ -99,7 +99,7 @@ run)
     done
     ;;
 *)
-    sed -n 2,21p "$0"
+    sed -n 2,22p "$0"
     exit 2
     ;;
 esac

@@ -51,9 +51,14 @@ fn wide_child_at(word: u32) -> WideChild {
     return WideChild(kd[word], kd[word + WIDE_W]);
 }
 
+// Whether slot `i` holds a child, `child` being its child word's value.
+fn wide_slot_ok(i: u32, child: u32) -> bool {
+    return child != WIDE_EMPTY && i < WIDE_W;
+}
+
 fn wide_slot(node: u32, i: u32) -> WideSlot {
     let c = wide_child_at(wide_child_word(node, i));
-    return WideSlot(c.child != WIDE_EMPTY && i < WIDE_W, c);
+    return WideSlot(wide_slot_ok(i, c.child), c);
 }
 
 // `ChildKernel::test`: each child box by the slab test over the widened interval. WT_T and WT_SLOT

@@ -75,7 +75,8 @@ fn wide_step() -> u32 {
         let slot = p.slot;
         if p.push && WS_LEN < WIDE_STACK {
             let word = wide_child_word(cur.child, slot);
-            if slot < WIDE_W && kd[word] != WIDE_EMPTY {
+            // The slot's emptiness alone, not `wide_slot`: the count is read back at the pop.
+            if wide_slot_ok(slot, kd[word]) {
                 WS_STACK[WS_LEN] = WideEntry(word, WT_T[k]);
                 WS_LEN = WS_LEN + 1u;
             }
