@@ -44,7 +44,8 @@ struct Params {
     record_stride: u32,
     // Node events kept per ray in `records` (enumerations).
     record_cap: u32,
-    // kd: short-stack entries, offset of the references and of the triangles in `kd`.
+    // kd: short-stack entries, offset of the references and of the triangles in `kd` (wide trees:
+    // of the triangle entries, in words; their references are in the entries).
     short_stack: u32,
     kd_prims: u32,
     kd_tris: u32,
@@ -60,12 +61,13 @@ struct Params {
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> rays: array<Ray>;
 @group(0) @binding(2) var<storage, read_write> hits: array<Hit>;
-// BVH2: internal nodes (four words each), then the leaf array from `P.leaf_base`.
+// BVH2: internal nodes (four words each), then the leaf array from `P.leaf_base`; or a wide BVH
+// (or the stream's level-order tree) read 16 bytes at a time, as wide.wgsl says.
 @group(0) @binding(3) var<storage, read> bvh: array<vec4<u32>>;
 // Perfect hash: the displacement table, then the cells from `P.d_mask + 1`.
 @group(0) @binding(4) var<storage, read> hash_tables: array<u32>;
 // kd-tree: nodes (two words each), references from `P.kd_prims`, triangles from `P.kd_tris`;
-// or a wide BVH, laid out as wide.wgsl says.
+// or a wide BVH (the same buffer as `bvh`), read word by word.
 @group(0) @binding(5) var<storage, read> kd: array<u32>;
 // Per ray: event count, counters, then node events (see record.wgsl).
 @group(0) @binding(6) var<storage, read_write> records: array<u32>;

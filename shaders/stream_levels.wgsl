@@ -1,6 +1,6 @@
 // The level-order 8-wide tree (`stream::LevelNode`, eight words a node) as the stream kernels read
-// it from the `kd` binding: nodes from word 0, then primitive ids from `P.kd_prims` and triangles
-// from `P.kd_tris`, the wide trees' layout, so wide.wgsl's leaf test reads the triangles.
+// it: nodes from word 0, then the triangle entries from `P.kd_tris`, the wide trees' layout (bound
+// as `kd` and as `bvh`), so wide.wgsl's leaf test reads the triangles.
 
 struct LevelNode {
     lo: vec3<f32>,
@@ -13,10 +13,9 @@ struct LevelNode {
 }
 
 fn level_node(i: u32) -> LevelNode {
-    let b = i * 8u;
-    let lo = bitcast<vec3<f32>>(vec3<u32>(kd[b], kd[b + 1u], kd[b + 2u]));
-    let hi = bitcast<vec3<f32>>(vec3<u32>(kd[b + 4u], kd[b + 5u], kd[b + 6u]));
-    return LevelNode(lo, kd[b + 3u], hi, kd[b + 7u]);
+    let a = bvh[2u * i];
+    let b = bvh[2u * i + 1u];
+    return LevelNode(bitcast<vec3<f32>>(a.xyz), a.w, bitcast<vec3<f32>>(b.xyz), b.w);
 }
 
 fn level_children(n: LevelNode) -> u32 {

@@ -4,10 +4,14 @@
 // (bvh4, bvh8, bvh4-naive, bvh8-sah), wide_packet.wgsl (bvh8-packet) and wide_trail.wgsl
 // (bvh4-hash); the stream method's intersection kernel reads the leaf test.
 //
-// Memory (the `kd` binding, words): nodes of 8 * WIDE_W words each (`wide::WideNode`: lo x, y, z,
-// hi x, y, z, children, counts; WIDE_W of each), the primitive id of each triangle position from
-// `P.kd_prims`, the triangles in leaf order from `P.kd_tris` (nine words each). WIDE_W comes in
-// the generated header.
+// Memory: nodes of 8 * WIDE_W words each (`wide::WideNode`: lo x, y, z, hi x, y, z, children,
+// counts; WIDE_W of each), then from word `P.kd_tris` each triangle in leaf order as three 16-byte
+// entries (a and the primitive id, b, c: the BVH2 leaf's triangle entries). WIDE_W comes in the
+// generated header. The buffer is bound twice: as `kd`, word by word, for the nodes, and as `bvh`,
+// 16 bytes at a time, for the triangles. A triangle at a 36-byte stride took ten word loads that
+// no compiler can merge; three aligned entries take three. The nodes stay word loads: read as
+// 16-byte rows they ran 0-20% slower on an H100 (BENCHMARKS.md, "the box tests reading 16-byte
+// words").
 
 const WIDE_EMPTY: u32 = 0xffffffffu;
 
@@ -137,14 +141,12 @@ fn wide_sort() {
 fn wide_leaf(first: u32, count: u32) -> bool {
     var taken = false;
     for (var pos = first; pos < first + count; pos = pos + 1u) {
-        let prim = kd[P.kd_prims + pos];
+        let e = P.kd_tris / 4u + pos * 3u;
+        let a = bvh[e];
         rec_primitive();
-        let o = P.kd_tris + pos * 9u;
-        let a = bitcast<vec3<f32>>(vec3<u32>(kd[o], kd[o + 1u], kd[o + 2u]));
-        let b = bitcast<vec3<f32>>(vec3<u32>(kd[o + 3u], kd[o + 4u], kd[o + 5u]));
-        let c = bitcast<vec3<f32>>(vec3<u32>(kd[o + 6u], kd[o + 7u], kd[o + 8u]));
-        let h = tri_intersect(a, b, c, C.tmin, q_limit());
-        if h.ok && q_offer(h, prim) {
+        let h = tri_intersect(bitcast<vec3<f32>>(a.xyz), bitcast<vec3<f32>>(bvh[e + 1u].xyz),
+            bitcast<vec3<f32>>(bvh[e + 2u].xyz), C.tmin, q_limit());
+        if h.ok && q_offer(h, a.w) {
             taken = true;
             if ANY_HIT {
                 return true;

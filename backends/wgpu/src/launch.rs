@@ -116,7 +116,6 @@ pub(crate) fn launch<'a>(
             let tree = scene.wide_for(m).ok_or(Error::NotPrepared { method: m.name(), missing: "its wide tree" })?;
             params.max_steps = root.max_steps;
             params.scene_scale = root.scene_scale;
-            params.kd_prims = tree.prims;
             params.kd_tris = tree.tris;
             (params.root, params.wide_root_count) = match root.root {
                 WideChild::Node(n) => (n, 0),
@@ -133,7 +132,9 @@ pub(crate) fn launch<'a>(
             } else {
                 &scene.empty
             };
-            SceneBindings { bvh: &scene.empty, hash, kd: &tree.buffer }
+            // Bound twice: by the word for a single child, by the 16 bytes for node rows and
+            // triangle entries (shaders/wide.wgsl).
+            SceneBindings { bvh: &tree.buffer, hash, kd: &tree.buffer }
         }
         other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
     };

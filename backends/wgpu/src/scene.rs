@@ -32,6 +32,15 @@ pub(crate) struct KdBuffer {
     pub tris: u32,
 }
 
+/// A wide tree (or the stream's level-order tree) on the device: nodes, then each triangle as
+/// three 16-byte entries, the primitive id in the first one's fourth word (the BVH2 leaf's
+/// triangle entries). The kernels read both by the 16 bytes (shaders/wide.wgsl).
+pub(crate) struct WideBuffer {
+    pub buffer: wgpu::Buffer,
+    /// Where the triangle entries start, in words (a multiple of four).
+    pub tris: u32,
+}
+
 /// A scene as the wgpu backend holds it.
 pub struct WgpuScene {
     /// The prepared scene (the host side: roots, layouts for canonical ids, key width).
@@ -41,16 +50,16 @@ pub struct WgpuScene {
     pub(crate) hash: Option<HashBuffer>,
     pub(crate) full_hash: Option<HashBuffer>,
     pub(crate) kd: Option<KdBuffer>,
-    /// The wide trees, laid out as the kd-tree is: nodes, primitive ids, triangles.
-    pub(crate) wide4: Option<KdBuffer>,
+    /// The wide trees.
+    pub(crate) wide4: Option<WideBuffer>,
     /// The hash over the 4-wide tree's node keys (bvh4-hash).
     pub(crate) wide4_hash: Option<HashBuffer>,
-    pub(crate) wide8: Option<KdBuffer>,
-    pub(crate) wide4_naive: Option<KdBuffer>,
-    pub(crate) wide8_sah: Option<KdBuffer>,
+    pub(crate) wide8: Option<WideBuffer>,
+    pub(crate) wide4_naive: Option<WideBuffer>,
+    pub(crate) wide8_sah: Option<WideBuffer>,
     /// The stream method's level-order tree, laid out as the wide trees are: nodes (eight words
     /// each, `LevelNode`), primitive ids, triangles.
-    pub(crate) levels: Option<KdBuffer>,
+    pub(crate) levels: Option<WideBuffer>,
     /// A small buffer bound where a kernel's unused bindings would be.
     pub(crate) empty: wgpu::Buffer,
     /// Batch buffers kept between traces (every method but the stream method, whose stage arrays
@@ -113,8 +122,28 @@ fn nodes_prims_triangles(
     })
 }
 
-fn wide<const W: usize>(gpu: &Gpu, label: &str, t: &WideBvh<W>) -> Result<KdBuffer, Error> {
-    nodes_prims_triangles(gpu, label, bytemuck::cast_slice(t.nodes()), t.prims(), t.triangles())
+/// Nodes, padded to 16 bytes, then the triangle entries of [`WideBuffer`].
+fn nodes_triangle_entries(
+    gpu: &Gpu,
+    label: &str,
+    nodes: &[u32],
+    prims: &[u32],
+    triangles: &[raytrail_core::geometry::Triangle],
+) -> Result<WideBuffer, Error> {
+    let tris = nodes.len().next_multiple_of(4);
+    let mut words = Vec::with_capacity(tris + triangles.len() * 12);
+    words.extend_from_slice(nodes);
+    words.resize(tris, 0);
+    for (t, &prim) in triangles.iter().zip(prims) {
+        let [a, b, c] = t.v.map(|v| v.to_array().map(f32::to_bits));
+        words.extend([a[0], a[1], a[2], prim, b[0], b[1], b[2], 0, c[0], c[1], c[2], 0]);
+    }
+    let tris = u32::try_from(tris).map_err(|_| device_error(format!("{label} exceeds 32-bit word offsets")))?;
+    Ok(WideBuffer { buffer: storage(gpu, label, &words)?, tris })
+}
+
+fn wide<const W: usize>(gpu: &Gpu, label: &str, t: &WideBvh<W>) -> Result<WideBuffer, Error> {
+    nodes_triangle_entries(gpu, label, bytemuck::cast_slice(t.nodes()), t.prims(), t.triangles())
 }
 
 fn hash(gpu: &Gpu, label: &str, h: &BuiltHash) -> Result<HashBuffer, Error> {
@@ -157,7 +186,7 @@ impl WgpuScene {
             .levels
             .as_ref()
             .map(|t| {
-                nodes_prims_triangles(
+                nodes_triangle_entries(
                     gpu,
                     "level-order tree",
                     bytemuck::cast_slice(t.nodes()),
@@ -219,7 +248,7 @@ impl WgpuScene {
     }
 
     /// The wide tree buffer `method` reads.
-    pub(crate) fn wide_for(&self, method: WideMethod) -> Option<&KdBuffer> {
+    pub(crate) fn wide_for(&self, method: WideMethod) -> Option<&WideBuffer> {
         match method {
             WideMethod::Bvh4 | WideMethod::Bvh4Hash => self.wide4.as_ref(),
             WideMethod::Bvh8 | WideMethod::Bvh8Packet => self.wide8.as_ref(),
@@ -233,16 +262,17 @@ impl WgpuScene {
         let l = |b: &Option<LayoutBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
         let h = |b: &Option<HashBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
         let k = |b: &Option<KdBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
+        let w = |b: &Option<WideBuffer>| b.as_ref().map_or(0, |b| b.buffer.size());
         l(&self.uncles)
             + l(&self.parents)
             + h(&self.hash)
             + h(&self.full_hash)
             + k(&self.kd)
-            + k(&self.wide4)
+            + w(&self.wide4)
             + h(&self.wide4_hash)
-            + k(&self.wide8)
-            + k(&self.wide4_naive)
-            + k(&self.wide8_sah)
-            + k(&self.levels)
+            + w(&self.wide8)
+            + w(&self.wide4_naive)
+            + w(&self.wide8_sah)
+            + w(&self.levels)
     }
 }

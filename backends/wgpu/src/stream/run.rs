@@ -153,7 +153,8 @@ impl<'a> Run<'a> {
             wgpu::BindGroupEntry { binding: 0, resource: f.params.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: f.rays.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 2, resource: f.hits.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: f.empty.as_entire_binding() },
+            // The level-order tree twice, as shaders/stream_levels.wgsl reads it.
+            wgpu::BindGroupEntry { binding: 3, resource: f.levels.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 4, resource: f.empty.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 5, resource: f.levels.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 6, resource: f.records.as_entire_binding() },

@@ -37,7 +37,6 @@ fn start<'a>(
         ray_count: n,
         scene_scale: s.scene_scale,
         record_stride: record_stride as u32,
-        kd_prims: levels.prims,
         kd_tris: levels.tris,
         ..Params::default()
     };
