@@ -74,20 +74,31 @@ fn wide_slot(node: u32, i: u32) -> WideSlot {
 var<private> WT_T: array<f32, WIDE_W>;
 var<private> WT_SLOT: array<u32, WIDE_W>;
 
+// Child `i`'s box test, its sort keys written at index `i` (a constant at every call).
+fn wide_test_child(node: u32, i: u32, lo_t: f32, hi_t: f32) -> u32 {
+    let lo = vec3<f32>(bitcast<f32>(wide_word(node, i)), bitcast<f32>(wide_word(node, WIDE_W + i)),
+        bitcast<f32>(wide_word(node, 2u * WIDE_W + i)));
+    let hi = vec3<f32>(bitcast<f32>(wide_word(node, 3u * WIDE_W + i)),
+        bitcast<f32>(wide_word(node, 4u * WIDE_W + i)), bitcast<f32>(wide_word(node, 5u * WIDE_W + i)));
+    let h = slab_hit(lo, hi, lo_t, hi_t);
+    // `sort_keys`: a missed child sorts after every hit one.
+    WT_T[i] = select(bitcast<f32>(0x7f800000u), h.t_enter, h.hit);
+    WT_SLOT[i] = select(i + WIDE_W, i, h.hit);
+    return select(0u, 1u << i, h.hit);
+}
+
+// 4-wide: written out child by child, as `wide_sort` is, rather than left to the driver to unroll;
+// on an H200 that made bvh4 1.00-1.18x faster (BENCHMARKS.md, "Loops written out"). 8-wide: the
+// loop, since written out there (with the stack's pushes) it lost 7-9% on AO and diffuse rays
+// while gaining on primary ones.
 fn wide_test(node: u32, lo_t: f32, hi_t: f32) -> u32 {
+    if WIDE_W == 4u {
+        return wide_test_child(node, 0u, lo_t, hi_t) | wide_test_child(node, 1u, lo_t, hi_t)
+            | wide_test_child(node, 2u, lo_t, hi_t) | wide_test_child(node, 3u, lo_t, hi_t);
+    }
     var mask = 0u;
     for (var i = 0u; i < WIDE_W; i = i + 1u) {
-        let lo = vec3<f32>(bitcast<f32>(wide_word(node, i)), bitcast<f32>(wide_word(node, WIDE_W + i)),
-            bitcast<f32>(wide_word(node, 2u * WIDE_W + i)));
-        let hi = vec3<f32>(bitcast<f32>(wide_word(node, 3u * WIDE_W + i)),
-            bitcast<f32>(wide_word(node, 4u * WIDE_W + i)), bitcast<f32>(wide_word(node, 5u * WIDE_W + i)));
-        let h = slab_hit(lo, hi, lo_t, hi_t);
-        // `sort_keys`: a missed child sorts after every hit one.
-        WT_T[i] = select(bitcast<f32>(0x7f800000u), h.t_enter, h.hit);
-        WT_SLOT[i] = select(i + WIDE_W, i, h.hit);
-        if h.hit {
-            mask = mask | (1u << i);
-        }
+        mask = mask | wide_test_child(node, i, lo_t, hi_t);
     }
     return mask;
 }

@@ -44,6 +44,19 @@ fn wide_pop() -> u32 {
     return STEP_DONE;
 }
 
+// Push `k` of a node's expansion (`wide_push`), if it is one.
+fn wide_stack_push(node: u32, k: u32, mask: u32, first_slot: u32, n: u32) {
+    let p = wide_push(k, mask, first_slot, n);
+    if p.push && WS_LEN < WIDE_STACK {
+        let word = wide_child_word(node, p.slot);
+        // The slot's emptiness alone, not `wide_slot`: the count is read back at the pop.
+        if wide_slot_ok(p.slot, kd[word]) {
+            WS_STACK[WS_LEN] = WideEntry(word, WT_T[k]);
+            WS_LEN = WS_LEN + 1u;
+        }
+    }
+}
+
 // `WideState::step`.
 fn wide_step() -> u32 {
     if !WS_HAS_CURRENT {
@@ -65,21 +78,17 @@ fn wide_step() -> u32 {
     }
     // All hit children but the first pushed, farthest first: for a closest-hit query by rank
     // after the network, for an any-hit query in descending slot order (unsorted, Sec. 4.2).
-    // Rank and slot run over constants; a miss sorts after every hit, so rank k < n is a hit.
-    // Slot 0 is never pushed: when hit, it is the first.
+    // A miss sorts after every hit, so rank k < n is a hit. Slot 0 is never pushed: when hit, it
+    // is the first. Written out for 4-wide nodes, a loop for 8-wide ones, as `wide_test` is.
     let first_slot = wide_order(mask);
     let n = countOneBits(mask);
-    for (var j = 1u; j < WIDE_W; j = j + 1u) {
-        let k = WIDE_W - j;
-        let p = wide_push(k, mask, first_slot, n);
-        let slot = p.slot;
-        if p.push && WS_LEN < WIDE_STACK {
-            let word = wide_child_word(cur.child, slot);
-            // The slot's emptiness alone, not `wide_slot`: the count is read back at the pop.
-            if wide_slot_ok(slot, kd[word]) {
-                WS_STACK[WS_LEN] = WideEntry(word, WT_T[k]);
-                WS_LEN = WS_LEN + 1u;
-            }
+    if WIDE_W == 4u {
+        wide_stack_push(cur.child, 3u, mask, first_slot, n);
+        wide_stack_push(cur.child, 2u, mask, first_slot, n);
+        wide_stack_push(cur.child, 1u, mask, first_slot, n);
+    } else {
+        for (var j = 1u; j < WIDE_W; j = j + 1u) {
+            wide_stack_push(cur.child, WIDE_W - j, mask, first_slot, n);
         }
     }
     let first = wide_slot(cur.child, first_slot);
