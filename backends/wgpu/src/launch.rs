@@ -132,8 +132,8 @@ pub(crate) fn launch<'a>(
             } else {
                 &scene.empty
             };
-            // Bound twice: by the word for a single child, by the 16 bytes for node rows and
-            // triangle entries (shaders/wide.wgsl).
+            // Bound twice: word by word for the nodes, 16 bytes at a time for the triangle entries
+            // (shaders/wide.wgsl).
             SceneBindings { bvh: &tree.buffer, hash, kd: &tree.buffer }
         }
         other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),

@@ -34,7 +34,7 @@ pub(crate) struct KdBuffer {
 
 /// A wide tree (or the stream's level-order tree) on the device: nodes, then each triangle as
 /// three 16-byte entries, the primitive id in the first one's fourth word (the BVH2 leaf's
-/// triangle entries). The kernels read both by the 16 bytes (shaders/wide.wgsl).
+/// triangle entries), which the kernels read 16 bytes at a time (shaders/wide.wgsl).
 pub(crate) struct WideBuffer {
     pub buffer: wgpu::Buffer,
     /// Where the triangle entries start, in words (a multiple of four).
@@ -58,7 +58,7 @@ pub struct WgpuScene {
     pub(crate) wide4_naive: Option<WideBuffer>,
     pub(crate) wide8_sah: Option<WideBuffer>,
     /// The stream method's level-order tree, laid out as the wide trees are: nodes (eight words
-    /// each, `LevelNode`), primitive ids, triangles.
+    /// each, `LevelNode`), then the triangle entries.
     pub(crate) levels: Option<WideBuffer>,
     /// A small buffer bound where a kernel's unused bindings would be.
     pub(crate) empty: wgpu::Buffer,
