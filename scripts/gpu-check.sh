@@ -17,7 +17,8 @@
 #
 # `run` writes each suite's log and, per scene, SCENE.txt and SCENE.json (SCENE-old.* for the old
 # binary) under $OUT (else /tmp/gpu-out). `quick` shrinks everything for a dry run on lavapipe;
-# SKIP_CONF=1 skips the suites; METHODS=a,b,... replaces the bench's methods. On an H100 the grid
+# SKIP_CONF=1 skips the suites, SUITES=conformance runs the grid suite alone (about 40 s on an
+# H200, half of both); METHODS=a,b,... replaces the bench's methods. On an H100 the grid
 # suite and the three scenes took about 4 minutes (BENCHMARKS.md, "On an NVIDIA H100
 # (2026-11-27)").
 set -uo pipefail
@@ -30,7 +31,7 @@ prepare)
     cargo build --release -p raytrail-cli
     rm -rf "$carry" && mkdir -p "$carry/scenes"
     strip -o "$carry/raytrail" target/release/raytrail
-    for suite in conformance conformance_persistent; do
+    for suite in ${SUITES:-conformance conformance_persistent}; do
         test=$(cargo test --release -p raytrail-wgpu --test $suite --no-run --message-format=json 2>/dev/null |
             sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -1)
         [ -n "$test" ] || { echo "the $suite test binary was not built" >&2; exit 1; }
@@ -69,7 +70,7 @@ run)
     if [ -n "$quick" ]; then size="-W 64 -H 48"; warm=0.05; passes=1; threads=2
     else size="-W 1920 -H 1080"; warm=0.3; passes=5; threads=16; fi
     # The grid suite, then every method on persistent threads (together: both dispatches).
-    for suite in conformance conformance_persistent; do
+    for suite in ${SUITES:-conformance conformance_persistent}; do
         [ -n "${SKIP_CONF:-}" ] && break
         echo "== $suite $(date +%T)"
         RAYTRAIL_REQUIRE_GPU=1 timeout 200 "$bin/$suite" --test-threads 4 >"$out/$suite.log" 2>&1
@@ -99,7 +100,7 @@ run)
     done
     ;;
 *)
-    sed -n 2,22p "$0"
+    awk 'NR > 1 && !/^#/ { exit } NR > 1' "$0"
     exit 2
     ;;
 esac
