@@ -3,7 +3,7 @@
 
 use crate::device::{device_error, Gpu};
 use crate::workspace::Workspace;
-use raytrail_core::bvh2::BinaryLayout;
+use raytrail_core::bvh2::{BinaryLayout, LeafWord};
 use raytrail_core::method::{Bvh2Method, WideMethod};
 use raytrail_core::prepared::{BuiltHash, PreparedScene};
 use raytrail_core::wide::WideBvh;
@@ -102,7 +102,7 @@ fn layout(gpu: &Gpu, label: &str, l: &BinaryLayout) -> Result<LayoutBuffer, Erro
 }
 
 /// Nodes, then primitive references, then triangles (nine words each), with the offsets of the
-/// last two: the kd-tree's layout, which the wide trees share.
+/// last two: the kd-tree's layout.
 fn nodes_prims_triangles(
     gpu: &Gpu,
     label: &str,
@@ -135,8 +135,12 @@ fn nodes_triangle_entries(
     words.extend_from_slice(nodes);
     words.resize(tris, 0);
     for (t, &prim) in triangles.iter().zip(prims) {
-        let [a, b, c] = t.v.map(|v| v.to_array().map(f32::to_bits));
-        words.extend([a[0], a[1], a[2], prim, b[0], b[1], b[2], 0, c[0], c[1], c[2], 0]);
+        let entries = [
+            LeafWord::vertex_entry(t.v[0], prim),
+            LeafWord::vertex_entry(t.v[1], 0),
+            LeafWord::vertex_entry(t.v[2], 0),
+        ];
+        words.extend_from_slice(bytemuck::cast_slice(&entries));
     }
     let tris = u32::try_from(tris).map_err(|_| device_error(format!("{label} exceeds 32-bit word offsets")))?;
     Ok(WideBuffer { buffer: storage(gpu, label, &words)?, tris })
