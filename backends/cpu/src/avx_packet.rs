@@ -11,9 +11,11 @@ use crate::avx::AvxKernel;
 use raytrail_core::intersect::{TriangleTest, FAR_PAD};
 use raytrail_core::method::Query;
 use raytrail_core::observe::Observer;
-use raytrail_core::wide::packet::{trace_wide_packets, PacketHits, PacketKernel, PacketRays, ReferencePacketKernel};
+use raytrail_core::wide::packet::{
+    trace_wide_packets, Lanes, PacketHits, PacketKernel, PacketRays, ReferencePacketKernel,
+};
 use raytrail_core::wide::traverse::WideRoot;
-use raytrail_core::wide::{WideMemory, WideNode, EMPTY_CHILD};
+use raytrail_core::wide::{ChildKernel, WideMemory, WideNode, EMPTY_CHILD};
 use raytrail_core::{Hit, Ray};
 use std::arch::x86_64::{
     __m256, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps256_ps128,
@@ -24,7 +26,7 @@ use std::arch::x86_64::{
 
 /// The packet kernel of [`trace_batch`]; private to it, whose caller has checked for AVX2 (what
 /// makes its unchecked AVX calls sound).
-struct AvxPacketKernel;
+pub(crate) struct AvxPacketKernel;
 
 impl PacketKernel for AvxPacketKernel {
     #[inline(always)]
@@ -34,6 +36,28 @@ impl PacketKernel for AvxPacketKernel {
             unsafe { test_avx(node, rays, mask) }
         } else {
             ReferencePacketKernel::test(node, rays, mask)
+        }
+    }
+
+    /// With the rays in the lanes ([`crate::avx_packet_leaf`]) where the test is the watertight
+    /// one; otherwise each ray alone.
+    #[inline(always)]
+    fn leaf<const W: usize, const N: usize, M, T, K, O>(
+        mem: &M,
+        first: u32,
+        count: u32,
+        mask: u64,
+        lanes: &mut Lanes<T, N>,
+        obs: &mut [O],
+    ) where
+        M: WideMemory<W> + ?Sized,
+        T: TriangleTest,
+        K: ChildKernel,
+        O: Observer,
+    {
+        // SAFETY: as `test`.
+        if unsafe { crate::avx_packet_leaf::leaf::<W, N, M, T, O>(mem, first, count, mask, lanes, obs) }.is_none() {
+            ReferencePacketKernel::leaf::<W, N, M, T, K, O>(mem, first, count, mask, lanes, obs);
         }
     }
 
@@ -175,32 +199,11 @@ pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: T
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_rng::Rng;
     use glam::Vec3;
     use raytrail_core::intersect::{NoPair, Watertight};
     use raytrail_core::traverse::begin;
     use raytrail_core::wide::WideChild;
-
-    /// xorshift64.
-    struct Rng(u64);
-
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-
-        /// Mostly ordinary values in [-4, 4], with zeros of both signs and exact repeats.
-        fn value(&mut self) -> f32 {
-            match self.next() % 12 {
-                0 => 0.0,
-                1 => -0.0,
-                2 => 1.0,
-                _ => ((self.next() >> 8) % 4001) as f32 / 500.0 - 4.0,
-            }
-        }
-    }
 
     /// Packets of 32 rays, half of them of one octant (where the interval cull applies), against
     /// nodes of random boxes with empty slots: every mask and key the reference's, and the rays

@@ -12,6 +12,8 @@
 mod avx;
 #[cfg(target_arch = "x86_64")]
 mod avx_packet;
+#[cfg(target_arch = "x86_64")]
+mod avx_packet_leaf;
 mod backend;
 mod bvh2;
 mod chunk;
@@ -19,6 +21,8 @@ mod kd;
 mod keyed;
 pub mod ploc;
 mod stream;
+#[cfg(all(test, target_arch = "x86_64"))]
+mod test_rng;
 mod wide;
 
 pub use backend::{CpuBackend, CpuScene};

@@ -19,7 +19,7 @@ pub use moller_trumbore::MollerTrumbore;
 pub use refine::{REFINE_SCALE, REFINE_ULPS};
 pub use slab::{BoxHit, SlabRay, FAR_PAD};
 pub use slab_pair::{hit_pair_scalar, SlabPair};
-pub use watertight::Watertight;
+pub use watertight::{ShearedRay, Watertight};
 
 use crate::Ray;
 use glam::Vec3;
@@ -63,5 +63,12 @@ pub trait TriangleTest: Copy + Default + Send + Sync + 'static {
             out.set(lane, Self::intersect_in_place(ray, [&a, &b, &c], tmin, tmax));
         }
         out
+    }
+    /// These per-ray constants as the watertight test's, where this test is that one (`None`
+    /// otherwise): a backend's own vector form of the watertight test reads them, and must give
+    /// [`TriangleTest::intersect_in_place`]'s answers bit for bit.
+    #[inline(always)]
+    fn sheared(_ray: &Self::PerRay) -> Option<&ShearedRay> {
+        None
     }
 }

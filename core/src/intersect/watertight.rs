@@ -27,6 +27,27 @@ pub struct ShearedRay {
     d: [f32; 3],
 }
 
+impl ShearedRay {
+    /// The origin's coordinates in the ray's axis order (`o[kx], o[ky], o[kz]`).
+    #[inline(always)]
+    pub fn origin(&self) -> [f32; 3] {
+        self.origin
+    }
+
+    /// The axis order `kx, ky, kz`: `kz` the dominant direction axis, `kx, ky` the other two in
+    /// the order that keeps the winding.
+    #[inline(always)]
+    pub fn axes(&self) -> [usize; 3] {
+        self.k
+    }
+
+    /// The shear constants `dx/dz, dy/dz, 1/dz` (in the ray's axis order).
+    #[inline(always)]
+    pub fn shear(&self) -> [f32; 3] {
+        self.s
+    }
+}
+
 impl TriangleTest for Watertight {
     type PerRay = ShearedRay;
     const NAME: &'static str = "watertight";
@@ -55,6 +76,11 @@ impl TriangleTest for Watertight {
         // `dx/dz, dy/dz, 1/dz` as one 4-wide division where SIMD is available (IEEE per lane).
         let s = d.with_z(1.0) / Vec3A::splat(d.z);
         ShearedRay { origin: o.to_array(), k: [kx, ky, kz], s: s.to_array(), d: d.to_array() }
+    }
+
+    #[inline(always)]
+    fn sheared(r: &ShearedRay) -> Option<&ShearedRay> {
+        Some(r)
     }
 
     #[inline(always)]

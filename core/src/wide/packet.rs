@@ -24,8 +24,9 @@
 //! box it enters before its closest hit, and ties go to the smaller primitive id whatever the
 //! order. Any-hit answers agree on occlusion (which occluder is found first may differ).
 //!
-//! The box tests of a node are a [`PacketKernel`]: the plain [`ReferencePacketKernel`], one ray
-//! and one child at a time, or a backend's vector test that equals it.
+//! The box tests of a node and the leaf tests are a [`PacketKernel`]: the plain
+//! [`ReferencePacketKernel`], one ray and one child at a time and each ray alone at a leaf, or a
+//! backend's vector tests that equal it.
 
 use super::kernel::{ChildHits, ChildKernel, ReferenceKernel};
 use super::memory::WideMemory;
@@ -78,6 +79,10 @@ pub struct PacketRays<const N: usize> {
     pub t_hi_max: f32,
 }
 
+/// Each lane's ray context and answer so far (`None` for a lane without a ray, or one that
+/// [`begin`] turned away).
+pub type Lanes<T, const N: usize> = [Option<(WideRayContext<T>, QueryState)>; N];
+
 /// The box tests of one node for a packet: per child slot, the rays that hit it and its key.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PacketHits<const W: usize> {
@@ -87,12 +92,36 @@ pub struct PacketHits<const W: usize> {
     pub rays: [u64; W],
 }
 
-/// Tests a node's children for the rays of a packet.
+/// Tests a node's children, and a leaf, for the rays of a packet.
 pub trait PacketKernel {
     /// For each child slot of `node`, the rays of `mask` whose single-ray slab test
     /// ([`SlabRay::hit_scalar`] over `[t_lo, t_hi]` with the ray's slack) hits it, and the least
     /// of their entry distances.
     fn test<const W: usize, const N: usize>(node: &WideNode<W>, rays: &PacketRays<N>, mask: u64) -> PacketHits<W>;
+
+    /// Tests leaf `(first, count)` for the rays of `mask`, each with its context and its answer
+    /// so far in `lanes`, as each ray would alone with the single-ray leaf test of `K`: the same
+    /// answers, and each ray's events in the same order. By default each ray alone, in lane order.
+    #[inline(always)]
+    fn leaf<const W: usize, const N: usize, M, T, K, O>(
+        mem: &M,
+        first: u32,
+        count: u32,
+        mask: u64,
+        lanes: &mut Lanes<T, N>,
+        obs: &mut [O],
+    ) where
+        M: WideMemory<W> + ?Sized,
+        T: TriangleTest,
+        K: ChildKernel,
+        O: Observer,
+    {
+        for_each_ray(mask, |i| {
+            if let Some((c, q)) = lanes[i].as_mut() {
+                leaf::<W, M, T, K, O>(mem, first, count, c, q, &mut obs[i]);
+            }
+        });
+    }
 
     /// The rays of `mask` whose box interval still reaches `key` (`key <= t_hi`).
     #[inline(always)]
@@ -181,7 +210,8 @@ struct Entry {
 }
 
 /// Traces one packet: `rays` (at most `N`, at most 64; the rest is ignored) over a `W`-wide tree,
-/// the children tested by `P` and ordered and the leaves tested by `K`, per the rule in the
+/// the children tested by `P` and ordered by `K`, the leaves tested by `P` with `K`'s leaf test
+/// (and the subtrees handed over walked with `K`), per the rule in the
 /// module docs. Answers go to `hits`, each ray's events to its own observer in `obs`.
 ///
 /// Inlined, so that a backend's caller compiled for a vector extension compiles all of it so.
@@ -203,7 +233,7 @@ pub fn trace_wide_packet<
     obs: &mut [O],
 ) {
     let n = rays.len().min(N).min(64).min(hits.len()).min(obs.len());
-    let mut ctx: [Option<(WideRayContext<T>, QueryState)>; N] = core::array::from_fn(|_| None);
+    let mut ctx: Lanes<T, N> = core::array::from_fn(|_| None);
     let mut p = PacketRays::<N>::EMPTY;
     let mut active = 0u64;
     for i in 0..n {
@@ -227,9 +257,12 @@ pub fn trace_wide_packet<
         let next = match child {
             _ if hand_over => {
                 let sub = WideRoot { root: child, ..root };
-                each_alone(mask, &mut ctx, &mut p, &mut active, query, obs, |c, q, o| {
-                    single.run::<M, T, K, O>(mem, sub, c, q, o)
+                for_each_ray(mask, |i| {
+                    if let Some((c, q)) = ctx[i].as_mut() {
+                        single.run::<M, T, K, O>(mem, sub, c, q, &mut obs[i]);
+                    }
                 });
+                settle(mask, &ctx, &mut p, &mut active, query);
                 pop::<N, P, O>(&stack, &mut len, &p, active, obs)
             }
             WideChild::Node(index) => {
@@ -256,9 +289,8 @@ pub fn trace_wide_packet<
                 }
             }
             WideChild::Leaf { first, count } => {
-                each_alone(mask, &mut ctx, &mut p, &mut active, query, obs, |c, q, o| {
-                    leaf::<W, M, T, K, O>(mem, first, count, c, q, o);
-                });
+                P::leaf::<W, N, M, T, K, O>(mem, first, count, mask, &mut ctx, obs);
+                settle(mask, &ctx, &mut p, &mut active, query);
                 pop::<N, P, O>(&stack, &mut len, &p, active, obs)
             }
         };
@@ -277,31 +309,24 @@ pub fn trace_wide_packet<
     }
 }
 
-/// Lets each ray of `mask`, in order, do `f` on its own (test a leaf, or walk a handed-over
-/// subtree), then takes an answered ray out of the packet and narrows the others' box intervals
-/// to their closest hits.
+/// After the rays of `mask` tested a leaf or walked a handed-over subtree: takes an answered ray
+/// out of the packet and narrows the others' box intervals to their closest hits.
 #[inline(always)]
-fn each_alone<T: TriangleTest, O: Observer, const N: usize>(
+fn settle<T: TriangleTest, const N: usize>(
     mask: u64,
-    ctx: &mut [Option<(WideRayContext<T>, QueryState)>; N],
+    ctx: &Lanes<T, N>,
     p: &mut PacketRays<N>,
     active: &mut u64,
     query: Query,
-    obs: &mut [O],
-    mut f: impl FnMut(&WideRayContext<T>, &mut QueryState, &mut O),
 ) {
-    let mut m = mask;
-    while m != 0 {
-        let i = m.trailing_zeros() as usize;
-        m &= m - 1;
-        let Some((c, q)) = ctx[i].as_mut() else { continue };
-        f(c, q, &mut obs[i]);
+    for_each_ray(mask, |i| {
+        let Some((c, q)) = ctx[i].as_ref() else { return };
         if q.is_answered() {
             *active &= !(1 << i);
         } else {
             p.t_hi[i] = c.box_interval(q.limit()).1;
         }
-    }
+    });
     // Lanes without a ray hold `-inf`, and closest-hit rays never leave the packet; an any-hit
     // ray's interval never shrinks, so the bound stays one (if looser) as its rays leave.
     if !query.is_any() {
@@ -311,7 +336,7 @@ fn each_alone<T: TriangleTest, O: Observer, const N: usize>(
 
 /// Calls `f` with each ray of `mask`, in order.
 #[inline(always)]
-fn for_each_ray(mut mask: u64, mut f: impl FnMut(usize)) {
+pub fn for_each_ray(mut mask: u64, mut f: impl FnMut(usize)) {
     while mask != 0 {
         f(mask.trailing_zeros() as usize);
         mask &= mask - 1;

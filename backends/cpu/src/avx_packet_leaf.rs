@@ -1,0 +1,344 @@
+//! A wide packet's leaf with the rays in the lanes: each triangle of the leaf against eight rays of
+//! the packet per AVX2 operation, where the single-ray test takes four triangles against one ray.
+//! A leaf that a packet reaches is reached by nine rays or more (fewer are handed over), so a
+//! triangle's loads and the test's chain of latencies are shared by eight rays.
+//!
+//! Each lane is the watertight test of its own ray: its coordinates picked in the ray's own axis
+//! order (a per-lane permutation of the triangle's nine floats), then the SSE block test's
+//! operations in its order. A lane with a zero edge function, or with a hit the error bound flags,
+//! takes the scalar test. The answers are the single-ray leaf's bit for bit, and each ray's events
+//! come in its order (triangle by triangle, up to an any-hit answer).
+
+use raytrail_core::intersect::{TriangleHit, TriangleTest, REFINE_SCALE};
+use raytrail_core::observe::Observer;
+use raytrail_core::wide::packet::Lanes;
+use raytrail_core::wide::WideMemory;
+use std::arch::x86_64::{
+    __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps, _mm256_cmp_ps, _mm256_div_ps,
+    _mm256_loadu_ps, _mm256_loadu_si256, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_permutevar8x32_ps,
+    _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps, _mm256_storeu_ps, _mm256_sub_ps, _CMP_EQ_OQ, _CMP_GT_OQ,
+    _CMP_LT_OQ, _CMP_NEQ_UQ, _CMP_NGT_UQ, _CMP_NLT_UQ,
+};
+
+/// Eight rays' watertight constants by lane.
+struct RayLanes {
+    /// Origins in each ray's axis order.
+    origin: [[f32; 8]; 3],
+    /// Shear constants.
+    shear: [[f32; 8]; 3],
+    /// Each ray's axis order.
+    axes: [[i32; 8]; 3],
+    /// Interval starts.
+    tmin: [f32; 8],
+    /// Interval ends: each ray's closest hit so far.
+    tmax: [f32; 8],
+}
+
+/// The answers of one triangle for eight rays: lanes hit, lanes for the scalar test, and the hit
+/// lanes' distances and barycentrics.
+struct TriangleLanes {
+    hit: u32,
+    slow: u32,
+    t: [f32; 8],
+    u: [f32; 8],
+    v: [f32; 8],
+}
+
+/// Tests leaf `(first, count)` for the rays of `mask` with the rays in lanes, packed eight to a
+/// register in lane order, where `T` is the watertight test; `None` (nothing done) otherwise.
+///
+/// # Safety
+/// The processor must support AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) unsafe fn leaf<const W: usize, const N: usize, M, T, O>(
+    mem: &M,
+    first: u32,
+    count: u32,
+    mask: u64,
+    lanes: &mut Lanes<T, N>,
+    obs: &mut [O],
+) -> Option<()>
+where
+    M: WideMemory<W> + ?Sized,
+    T: TriangleTest,
+    O: Observer,
+{
+    let mut rest = mask;
+    while rest != 0 {
+        // The next eight rays of the mask, lane `k` holding ray `ray[k]`.
+        let mut r = RayLanes {
+            origin: [[0.0; 8]; 3],
+            shear: [[0.0; 8]; 3],
+            axes: [[0; 8]; 3],
+            tmin: [f32::INFINITY; 8],
+            tmax: [f32::NEG_INFINITY; 8],
+        };
+        let (mut ray, mut live) = ([0usize; 8], 0u32);
+        for (k, slot) in ray.iter_mut().enumerate() {
+            if rest == 0 {
+                break;
+            }
+            let i = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let Some((c, q)) = lanes.get(i).and_then(Option::as_ref) else { continue };
+            // `T` is the watertight test for every ray or for none: nothing is tested before the
+            // first ray's constants decide.
+            let per_ray = c.tri();
+            let s = T::sheared(&per_ray)?;
+            let (o, axes, shear) = (s.origin(), s.axes(), s.shear());
+            for a in 0..3 {
+                (r.origin[a][k], r.shear[a][k], r.axes[a][k]) = (o[a], shear[a], axes[a] as i32);
+            }
+            (r.tmin[k], r.tmax[k]) = (c.ray.tmin, q.limit());
+            *slot = i;
+            live |= 1 << k;
+        }
+        for pos in first..first + count {
+            if live == 0 {
+                break;
+            }
+            let tri = mem.wide_triangle(pos);
+            let h = triangle(&r, tri.as_ptr().cast());
+            let prim = mem.prim(pos);
+            let mut m = if O::ENABLED { live } else { live & (h.hit | h.slow) };
+            while m != 0 {
+                let k = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let (bit, i) = (1 << k, ray[k]);
+                if O::ENABLED {
+                    obs[i].primitive(prim);
+                }
+                let Some((c, q)) = lanes[i].as_mut() else { continue };
+                let found = if h.slow & bit != 0 {
+                    let [a, b, cv] = &*tri;
+                    T::intersect_in_place(&c.tri(), [a.as_ref(), b.as_ref(), cv.as_ref()], r.tmin[k], r.tmax[k])
+                } else if h.hit & bit != 0 {
+                    Some(TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] })
+                } else {
+                    None
+                };
+                if let Some(hit) = found.filter(|hit| q.offer(*hit, prim)) {
+                    if O::ENABLED {
+                        obs[i].hit(prim, hit.t);
+                    }
+                    if q.any {
+                        live &= !bit;
+                    }
+                    r.tmax[k] = q.limit();
+                }
+            }
+        }
+    }
+    Some(())
+}
+
+/// One triangle (its nine floats from `v`) against the rays of `r`.
+///
+/// # Safety
+/// The processor must support AVX2; `v` must point to nine readable floats.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn triangle(r: &RayLanes, v: *const f32) -> TriangleLanes {
+    let splat = |x: f32| _mm256_set1_ps(x);
+    let ld = |a: &[f32; 8]| _mm256_loadu_ps(a.as_ptr());
+    let ldi = |a: &[i32; 8]| _mm256_loadu_si256(a.as_ptr().cast::<__m256i>());
+    // The first eight floats (a, b, and c's x and y), and the eight from the second (c's z last).
+    let (head, tail) = (_mm256_loadu_ps(v), _mm256_loadu_ps(v.add(1)));
+    let axes = [ldi(&r.axes[0]), ldi(&r.axes[1]), ldi(&r.axes[2])];
+    // Vertex `j`'s coordinate on each lane's axis `a`: float `3 j + axis`, c's from `tail`.
+    let pick = |j: i32, a: usize| {
+        if j < 2 {
+            _mm256_permutevar8x32_ps(head, _mm256_add_epi32(axes[a], _mm256_set1_epi32(3 * j)))
+        } else {
+            _mm256_permutevar8x32_ps(tail, _mm256_add_epi32(axes[a], _mm256_set1_epi32(5)))
+        }
+    };
+    let (ox, oy, oz) = (ld(&r.origin[0]), ld(&r.origin[1]), ld(&r.origin[2]));
+    let rel = |j: i32| (_mm256_sub_ps(pick(j, 0), ox), _mm256_sub_ps(pick(j, 1), oy), _mm256_sub_ps(pick(j, 2), oz));
+    let ((a0, a1, a2), (b0, b1, b2), (c0, c1, c2)) = (rel(0), rel(1), rel(2));
+    let (sxv, syv, szv) = (ld(&r.shear[0]), ld(&r.shear[1]), ld(&r.shear[2]));
+    let ax = _mm256_sub_ps(a0, _mm256_mul_ps(sxv, a2));
+    let ay = _mm256_sub_ps(a1, _mm256_mul_ps(syv, a2));
+    let bx = _mm256_sub_ps(b0, _mm256_mul_ps(sxv, b2));
+    let by = _mm256_sub_ps(b1, _mm256_mul_ps(syv, b2));
+    let cx = _mm256_sub_ps(c0, _mm256_mul_ps(sxv, c2));
+    let cy = _mm256_sub_ps(c1, _mm256_mul_ps(syv, c2));
+    let u = _mm256_sub_ps(_mm256_mul_ps(cx, by), _mm256_mul_ps(cy, bx));
+    let v = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
+    let w = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
+    let z = _mm256_setzero_ps();
+    let eq = |x: __m256| _mm256_cmp_ps::<_CMP_EQ_OQ>(x, z);
+    let lt = |x: __m256| _mm256_cmp_ps::<_CMP_LT_OQ>(x, z);
+    let gt = |x: __m256| _mm256_cmp_ps::<_CMP_GT_OQ>(x, z);
+    let zero = _mm256_or_ps(_mm256_or_ps(eq(u), eq(v)), eq(w));
+    let neg = _mm256_or_ps(_mm256_or_ps(lt(u), lt(v)), lt(w));
+    let pos = _mm256_or_ps(_mm256_or_ps(gt(u), gt(v)), gt(w));
+    let det = _mm256_add_ps(_mm256_add_ps(u, v), w);
+    let az = _mm256_mul_ps(szv, a2);
+    let bz = _mm256_mul_ps(szv, b2);
+    let cz = _mm256_mul_ps(szv, c2);
+    let t = _mm256_div_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, az), _mm256_mul_ps(v, bz)), _mm256_mul_ps(w, cz)),
+        det,
+    );
+    let abs = |x: __m256| _mm256_andnot_ps(splat(-0.0), x);
+    // `!t.is_finite() || t < tmin || t > tmax` rejects: NaN fails `|t| < inf`.
+    let finite = _mm256_cmp_ps::<_CMP_LT_OQ>(abs(t), splat(f32::INFINITY));
+    let det_ok = _mm256_cmp_ps::<_CMP_NEQ_UQ>(det, z);
+    let ahead = _mm256_and_ps(
+        _mm256_andnot_ps(_mm256_and_ps(neg, pos), det_ok),
+        _mm256_and_ps(finite, _mm256_cmp_ps::<_CMP_NLT_UQ>(t, ld(&r.tmin))),
+    );
+    let ok = _mm256_and_ps(ahead, _mm256_cmp_ps::<_CMP_NGT_UQ>(t, ld(&r.tmax)));
+    let zero = _mm256_movemask_ps(zero) as u32;
+    let mut slow = zero;
+    let screened = _mm256_movemask_ps(ahead) as u32 & !zero;
+    if screened != 0 {
+        let m = |p0: __m256, p1: __m256, p2: __m256| {
+            _mm256_add_ps(_mm256_add_ps(abs(p0), abs(p1)), _mm256_add_ps(abs(p2), abs(p2)))
+        };
+        let (ma, mb, mc) = (m(a0, a1, a2), m(b0, b1, b2), m(c0, c1, c2));
+        let (sa, sb, sc) =
+            (_mm256_add_ps(abs(ax), abs(ay)), _mm256_add_ps(abs(bx), abs(by)), _mm256_add_ps(abs(cx), abs(cy)));
+        let e = |mp: __m256, sq: __m256, mq: __m256, sp: __m256| {
+            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(mp, sq), _mm256_mul_ps(mq, sp)), _mm256_mul_ps(sp, sq))
+        };
+        let (eu, ev, ew) = (e(mb, sc, mc, sb), e(mc, sa, ma, sc), e(ma, sb, mb, sa));
+        let dz = |zz: __m256| abs(_mm256_sub_ps(zz, t));
+        let lhs = _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(eu, dz(az)), _mm256_mul_ps(ev, dz(bz))),
+            _mm256_mul_ps(ew, dz(cz)),
+        );
+        let rhs = _mm256_mul_ps(splat(REFINE_SCALE), abs(_mm256_mul_ps(t, det)));
+        slow |= _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(lhs, rhs)) as u32 & screened;
+    }
+    let hit = _mm256_movemask_ps(ok) as u32 & !slow;
+    let store = |x: __m256| {
+        let mut out = [0.0f32; 8];
+        _mm256_storeu_ps(out.as_mut_ptr(), x);
+        out
+    };
+    if hit == 0 {
+        return TriangleLanes { hit, slow, t: [0.0; 8], u: [0.0; 8], v: [0.0; 8] };
+    }
+    TriangleLanes { hit, slow, t: store(t), u: store(_mm256_div_ps(v, det)), v: store(_mm256_div_ps(w, det)) }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::avx::AvxKernel;
+    use crate::test_rng::Rng;
+    use glam::Vec3;
+    use raytrail_core::geometry::Triangle;
+    use raytrail_core::intersect::{NoPair, TriangleBlock, TriangleHit, Watertight};
+    use raytrail_core::method::Query;
+    use raytrail_core::observe::{NoObserver, Observer};
+    use raytrail_core::traverse::begin;
+    use raytrail_core::wide::packet::{Lanes, PacketKernel, ReferencePacketKernel};
+    use raytrail_core::wide::{FastKernel, WideSliceMemory};
+    use raytrail_core::Ray;
+
+    /// Each test and each accepted hit, in order.
+    #[derive(Debug, Default, PartialEq)]
+    struct Log(Vec<(u32, Option<u32>)>);
+
+    impl Observer for Log {
+        fn primitive(&mut self, prim: u32) {
+            self.0.push((prim, None));
+        }
+        fn hit(&mut self, prim: u32, t: f32) {
+            self.0.push((prim, Some(t.to_bits())));
+        }
+    }
+
+    /// Leaves of one to eight triangles sharing vertices on a coarse grid (so edge functions are
+    /// often exactly zero), packets of 32 rays aimed at their vertices, edges and insides, some
+    /// with a closest hit already: the lanes' answers and each ray's events are the single-ray
+    /// leaf's, with and without an observer.
+    #[test]
+    fn rays_in_lanes_match_the_single_ray_leaf() {
+        if !crate::avx::available() {
+            eprintln!("SKIPPED the AVX2 packet leaf test: this processor has no AVX2");
+            return;
+        }
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let (mut hits, mut answered_early) = (0, 0);
+        for round in 0..3000 {
+            let count = 1 + round % 8;
+            let pool: Vec<Vec3> = (0..5).map(|_| Vec3::new(rng.value(), rng.value(), rng.value())).collect();
+            let mut pick = || pool[(rng.next() % 5) as usize];
+            let triangles: Vec<Triangle> = (0..count).map(|_| Triangle::new(pick(), pick(), pick())).collect();
+            let blocks: Vec<TriangleBlock> = triangles.chunks(4).map(TriangleBlock::new).collect();
+            let prims: Vec<u32> = (0..count as u32).map(|i| (i * 7 + round as u32) % 11).collect();
+            let mem = WideSliceMemory::<8> { nodes: &[], triangles: &triangles, blocks: &blocks, prims: &prims };
+            let query = if round % 3 == 0 { Query::Any } else { Query::Closest };
+            let mut lanes: Lanes<Watertight, 32> = core::array::from_fn(|_| None);
+            let mut mask = 0u64;
+            for (i, lane) in lanes.iter_mut().enumerate() {
+                let tri = triangles[(rng.next() % count as u64) as usize];
+                let weights = [0.0, 0.5, 1.0, 0.25].map(|_| (rng.next() % 5) as f32 / 4.0);
+                let target = tri.v[0] * weights[0] + tri.v[1] * weights[1] + tri.v[2] * (1.0 - weights[0] - weights[1]);
+                let origin = Vec3::new(rng.value(), rng.value(), rng.value()) * 2.0;
+                let dir = target - origin;
+                let ray = Ray::new(
+                    origin,
+                    dir,
+                    [0.0, 0.5][(rng.next() % 2) as usize],
+                    [f32::INFINITY, 1.0][(rng.next() % 2) as usize],
+                );
+                let Some((ctx, mut q)) = begin::<Watertight, NoPair>(&ray, 8.0, query) else { continue };
+                if query == Query::Closest && rng.next() % 4 == 0 {
+                    q.offer(TriangleHit { t: (rng.next() % 8) as f32 / 4.0, u: 0.0, v: 0.0 }, (rng.next() % 11) as u32);
+                }
+                *lane = Some((ctx, q));
+                if rng.next() % 5 != 0 {
+                    mask |= 1 << i;
+                }
+            }
+            let (mut want, mut got, mut quiet) = (lanes.clone(), lanes.clone(), lanes);
+            let (mut want_log, mut got_log): (Vec<Log>, Vec<Log>) =
+                ((0..32).map(|_| Log::default()).collect(), (0..32).map(|_| Log::default()).collect());
+            let first = 0;
+            ReferencePacketKernel::leaf::<8, 32, _, _, FastKernel, _>(
+                &mem,
+                first,
+                count as u32,
+                mask,
+                &mut want,
+                &mut want_log,
+            );
+            crate::avx_packet::AvxPacketKernel::leaf::<8, 32, _, _, AvxKernel, _>(
+                &mem,
+                first,
+                count as u32,
+                mask,
+                &mut got,
+                &mut got_log,
+            );
+            let mut no_obs: Vec<NoObserver> = (0..32).map(|_| NoObserver).collect();
+            crate::avx_packet::AvxPacketKernel::leaf::<8, 32, _, _, AvxKernel, _>(
+                &mem,
+                first,
+                count as u32,
+                mask,
+                &mut quiet,
+                &mut no_obs,
+            );
+            for i in 0..32 {
+                let answer = |l: &Lanes<Watertight, 32>| {
+                    l[i].as_ref().map(|(_, q)| (q.hit.prim, [q.hit.t, q.hit.u, q.hit.v].map(f32::to_bits)))
+                };
+                assert_eq!(answer(&got), answer(&want), "round {round}, lane {i}: {triangles:?}");
+                assert_eq!(answer(&quiet), answer(&want), "round {round}, lane {i}, no observer");
+                assert_eq!(got_log[i], want_log[i], "round {round}, lane {i}: events");
+                let log = &want_log[i].0;
+                hits += log.iter().filter(|e| e.1.is_some()).count();
+                answered_early +=
+                    usize::from(query == Query::Any && log.len() < count && log.last().is_some_and(|e| e.1.is_some()));
+            }
+        }
+        assert!(hits > 10_000, "only {hits} hits");
+        assert!(answered_early > 1_000, "only {answered_early} any-hit rays answered before the leaf's end");
+    }
+}
