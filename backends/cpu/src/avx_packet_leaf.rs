@@ -8,6 +8,11 @@
 //! operations in its order. A lane with a zero edge function, or with a hit the error bound flags,
 //! takes the scalar test. The answers are the single-ray leaf's bit for bit, and each ray's events
 //! come in its order (triangle by triangle, up to an any-hit answer).
+//!
+//! The arithmetic is the SSE block test's (`raytrail_core`'s watertight test) written again for
+//! 256-bit registers. One form generic over the register width would call the AVX intrinsics from
+//! a function not compiled for AVX, and the compiler then leaves them as calls (0.18-0.84x when
+//! tried: BENCHMARKS.md, "Packet leaves with the rays in the lanes").
 
 use raytrail_core::intersect::{TriangleHit, TriangleTest, REFINE_SCALE};
 use raytrail_core::observe::Observer;
@@ -99,6 +104,8 @@ where
                 break;
             }
             let tri = mem.wide_triangle(pos);
+            // SAFETY: AVX2 is this function's own precondition; a triangle's three vertices are
+            // nine contiguous floats.
             let h = triangle(&r, tri.as_ptr().cast());
             let prim = mem.prim(pos);
             let mut m = if O::ENABLED { live } else { live & (h.hit | h.slow) };
@@ -277,8 +284,10 @@ mod tests {
             let mut mask = 0u64;
             for (i, lane) in lanes.iter_mut().enumerate() {
                 let tri = triangles[(rng.next() % count as u64) as usize];
-                let weights = [0.0, 0.5, 1.0, 0.25].map(|_| (rng.next() % 5) as f32 / 4.0);
-                let target = tri.v[0] * weights[0] + tri.v[1] * weights[1] + tri.v[2] * (1.0 - weights[0] - weights[1]);
+                // Barycentric weights in quarters: vertices, edges, insides, and points outside.
+                let mut weight = || (rng.next() % 5) as f32 / 4.0;
+                let (w0, w1) = (weight(), weight());
+                let target = tri.v[0] * w0 + tri.v[1] * w1 + tri.v[2] * (1.0 - w0 - w1);
                 let origin = Vec3::new(rng.value(), rng.value(), rng.value()) * 2.0;
                 let dir = target - origin;
                 let ray = Ray::new(
