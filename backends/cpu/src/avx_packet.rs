@@ -24,8 +24,9 @@ use std::arch::x86_64::{
     _mm256_sub_ps, _mm_cvtss_f32, _mm_min_ps, _mm_min_ss, _mm_movehl_ps, _mm_shuffle_ps, _CMP_GT_OQ, _CMP_LE_OQ,
 };
 
-/// The packet kernel of [`trace_batch`]; private to it, whose caller has checked for AVX2 (what
-/// makes its unchecked AVX calls sound).
+/// The packet kernel of [`trace_batch`], used only there (and by the tests, after their own AVX2
+/// check): `trace_batch`'s caller has checked for AVX2, which makes its unchecked AVX calls
+/// sound.
 pub(crate) struct AvxPacketKernel;
 
 impl PacketKernel for AvxPacketKernel {
