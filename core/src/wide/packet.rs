@@ -116,10 +116,8 @@ pub trait PacketKernel {
         K: ChildKernel,
         O: Observer,
     {
-        for_each_ray(mask, |i| {
-            if let Some((c, q)) = lanes[i].as_mut() {
-                leaf::<W, M, T, K, O>(mem, first, count, c, q, &mut obs[i]);
-            }
+        each_alone(mask, lanes, obs, |c, q, o| {
+            leaf::<W, M, T, K, O>(mem, first, count, c, q, o);
         });
     }
 
@@ -257,11 +255,7 @@ pub fn trace_wide_packet<
         let next = match child {
             _ if hand_over => {
                 let sub = WideRoot { root: child, ..root };
-                for_each_ray(mask, |i| {
-                    if let Some((c, q)) = ctx[i].as_mut() {
-                        single.run::<M, T, K, O>(mem, sub, c, q, &mut obs[i]);
-                    }
-                });
+                each_alone(mask, &mut ctx, obs, |c, q, o| single.run::<M, T, K, O>(mem, sub, c, q, o));
                 settle(mask, &ctx, &mut p, &mut active, query);
                 pop::<N, P, O>(&stack, &mut len, &p, active, obs)
             }
@@ -307,6 +301,22 @@ pub fn trace_wide_packet<
             hits[i] = q.hit;
         }
     }
+}
+
+/// Lets each ray of `mask`, in lane order, do `f` on its own (test a leaf, or walk a handed-over
+/// subtree) with its context, its answer so far and its observer.
+#[inline(always)]
+fn each_alone<T: TriangleTest, O: Observer, const N: usize>(
+    mask: u64,
+    lanes: &mut Lanes<T, N>,
+    obs: &mut [O],
+    mut f: impl FnMut(&WideRayContext<T>, &mut QueryState, &mut O),
+) {
+    for_each_ray(mask, |i| {
+        if let Some((c, q)) = lanes[i].as_mut() {
+            f(c, q, &mut obs[i]);
+        }
+    });
 }
 
 /// After the rays of `mask` tested a leaf or walked a handed-over subtree: takes an answered ray
