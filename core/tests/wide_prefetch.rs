@@ -1,10 +1,11 @@
 //! Prefetching the hit children of wide nodes: a hint that changes no answer and no event, taken
-//! only for incoherent closest-hit rays over trees larger than the caches.
+//! only for incoherent rays over trees larger than the caches (any-hit rays only in packets).
 
 use glam::Vec3;
 use raytrail_core::intersect::Watertight;
 use raytrail_core::method::{Collapse, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
+use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{
     worth_prefetching, FastKernel, PrefetchingMemory, ReferenceKernel, WideBvh, PREFETCH_ABOVE_BYTES,
@@ -69,18 +70,64 @@ fn prefetching_changes_no_answer_and_no_event() {
     assert!(visited > 10_000, "only {visited} internal nodes visited");
 }
 
+/// Packets (whose handed-over subtrees prefetch) on prefetching memory: the same answers and
+/// each ray's events as on plain memory.
+fn packets_same_as_plain<const W: usize>(wide: &WideBvh<W>, scale: f32) -> u64 {
+    let root = WideRoot { root: wide.root(), scene_scale: scale, max_steps: u32::MAX };
+    let rays = scattered(1000, 11 + W as u64);
+    let mut visited = 0;
+    for query in [Query::Closest, Query::Any] {
+        let trace = |fetching: bool| {
+            let mut hits = vec![Hit::MISS; rays.len()];
+            let mut events = vec![(Counters::default(), Vec::new()); rays.len()];
+            let done = |i: usize, o: Both<Counters, Recorder>| events[i] = (o.0, o.1.nodes);
+            if fetching {
+                let mem = PrefetchingMemory(wide.memory());
+                trace_wide_packets::<W, _, Watertight, FastKernel, ReferencePacketKernel, _>(
+                    &mem, root, &rays, &mut hits, query, done,
+                );
+            } else {
+                trace_wide_packets::<W, _, Watertight, FastKernel, ReferencePacketKernel, _>(
+                    &wide.memory(),
+                    root,
+                    &rays,
+                    &mut hits,
+                    query,
+                    done,
+                );
+            }
+            (hits.iter().map(|h| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits())).collect::<Vec<_>>(), events)
+        };
+        let (plain, fetched) = (trace(false), trace(true));
+        assert_eq!(fetched, plain, "{query:?}");
+        visited += plain.1.iter().map(|e| e.0.internal_nodes).sum::<u64>();
+    }
+    visited
+}
+
 #[test]
-fn only_incoherent_closest_hit_rays_over_large_trees_prefetch() {
+fn prefetching_changes_no_packet_answer_and_no_event() {
+    let (scale, w4, w8) = wide_soup(3000, 17, Collapse::Optimal);
+    let visited = packets_same_as_plain::<4>(&w4, scale) + packets_same_as_plain::<8>(&w8, scale);
+    assert!(visited > 10_000, "only {visited} internal nodes visited");
+}
+
+#[test]
+fn only_incoherent_rays_over_large_trees_prefetch_and_any_hit_ones_only_in_packets() {
     let large = PREFETCH_ABOVE_BYTES + 1;
     let (scattered, camera) = (scattered(256, 5), camera(256));
-    assert!(worth_prefetching(large, &scattered, Query::Closest));
-    assert!(!worth_prefetching(PREFETCH_ABOVE_BYTES, &scattered, Query::Closest), "a tree that fits the caches");
-    assert!(!worth_prefetching(large, &scattered, Query::Any), "any-hit rays");
-    assert!(!worth_prefetching(large, &camera, Query::Closest), "coherent camera rays");
+    assert!(worth_prefetching(large, &scattered, Query::Closest, false));
+    assert!(!worth_prefetching(PREFETCH_ABOVE_BYTES, &scattered, Query::Closest, false), "a tree that fits the caches");
+    assert!(!worth_prefetching(large, &scattered, Query::Any, false), "any-hit rays alone");
+    assert!(worth_prefetching(large, &scattered, Query::Any, true), "any-hit rays in packets");
+    assert!(worth_prefetching(large, &scattered, Query::Closest, true), "closest-hit rays in packets");
+    assert!(!worth_prefetching(large, &camera, Query::Any, true), "coherent rays in packets");
+    assert!(!worth_prefetching(PREFETCH_ABOVE_BYTES, &scattered, Query::Any, true), "a small tree, in packets");
+    assert!(!worth_prefetching(large, &camera, Query::Closest, false), "coherent camera rays");
     // Too few rays to judge, and degenerate directions (zero, NaN), decide without a panic.
-    assert!(!worth_prefetching(large, &scattered[..1], Query::Closest));
-    assert!(!worth_prefetching(large, &[], Query::Closest));
+    assert!(!worth_prefetching(large, &scattered[..1], Query::Closest, false));
+    assert!(!worth_prefetching(large, &[], Query::Closest, false));
     let odd: Vec<Ray> =
         (0..64).map(|i| Ray::new(Vec3::ZERO, if i % 2 == 0 { Vec3::ZERO } else { Vec3::NAN }, 0.0, 1.0)).collect();
-    assert!(worth_prefetching(large, &odd, Query::Closest), "no pair of these is close");
+    assert!(worth_prefetching(large, &odd, Query::Closest, false), "no pair of these is close");
 }

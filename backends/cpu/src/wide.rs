@@ -1,8 +1,9 @@
 //! The wide-BVH methods' loop for one chunk, monomorphized per width x memory x triangle test x
 //! recording, with the fast child kernel (SIMD box tests, the sorting network), in the AVX2 loop
 //! where the processor has AVX2; the packet method's loop over the chunk's packets likewise. The
-//! memory prefetches hit children where that pays (a large tree, incoherent closest-hit rays:
-//! [`worth_prefetching`]; the packet loop does not prefetch).
+//! memory prefetches hit children where that pays (a large tree, incoherent rays, any-hit ones only
+//! in packets: [`worth_prefetching`]; in the packet loop, only the subtrees handed over to single
+//! rays prefetch).
 
 use crate::chunk::Chunk;
 use core::marker::PhantomData;
@@ -43,11 +44,10 @@ struct WideRun<'a> {
 }
 
 impl WideRun<'_> {
-    /// Prefetches hit children where that pays ([`worth_prefetching`]; never in the packet loop,
-    /// which does not prefetch, so it is not compiled twice).
+    /// Prefetches hit children where that pays ([`worth_prefetching`]).
     fn go<const W: usize>(&self, mem: WideSliceMemory<'_, W>, chunk: Chunk<'_>) -> Result<Counters, Error> {
         let bytes = core::mem::size_of_val(mem.nodes) + core::mem::size_of_val(mem.blocks);
-        if !self.method.packets() && worth_prefetching(bytes, chunk.rays, self.opts.query) {
+        if worth_prefetching(bytes, chunk.rays, self.opts.query, self.method.packets()) {
             self.test(&PrefetchingMemory(mem), chunk)
         } else {
             self.test(&mem, chunk)

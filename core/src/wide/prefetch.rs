@@ -23,18 +23,21 @@ use glam::Vec3;
 pub const PREFETCH_ABOVE_BYTES: usize = 16 << 20;
 
 /// Whether a batch of `rays` answering `query` over a tree of `tree_bytes` (nodes and triangle
-/// blocks) is traced faster with [`PrefetchingMemory`]: closest-hit rays, incoherent, over a tree
-/// larger than [`PREFETCH_ABOVE_BYTES`].
+/// blocks) is traced faster with [`PrefetchingMemory`]: incoherent rays over a tree larger than
+/// [`PREFETCH_ABOVE_BYTES`], closest-hit rays whether walked alone or in packets (`packets`: a
+/// packet method's, whose rays prefetch in the subtrees handed over to them), any-hit rays only in
+/// packets.
 ///
 /// - Any-hit rays stop at their first occluder, often before the children fetched for them are
-///   visited: on the dragon, ambient-occlusion rays gained 4-8% from outside but 0.96-1.04 from
-///   inside, so they go without.
+///   visited. Alone, on the dragon, ambient-occlusion rays gained 2-8% from outside but lost up to
+///   6% from inside, so they go without. In packets they gained 7-12% from outside and held even
+///   from inside (BENCHMARKS.md, "Prefetching in the packets' handed-over subtrees").
 /// - Coherence is judged on up to 32 pairs of neighbouring rays spread over the batch: where at
 ///   least a quarter of them point within about 18 degrees of each other (as neighbouring camera
 ///   rays do), the previous ray will have brought the nodes in. Two directions drawn at random over
 ///   a hemisphere pass that test about one time in twenty.
-pub fn worth_prefetching(tree_bytes: usize, rays: &[Ray], query: Query) -> bool {
-    if query != Query::Closest || tree_bytes <= PREFETCH_ABOVE_BYTES || rays.len() < 2 {
+pub fn worth_prefetching(tree_bytes: usize, rays: &[Ray], query: Query, packets: bool) -> bool {
+    if (query != Query::Closest && !packets) || tree_bytes <= PREFETCH_ABOVE_BYTES || rays.len() < 2 {
         return false;
     }
     let pairs = (rays.len() - 1).min(32);
