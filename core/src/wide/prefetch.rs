@@ -30,8 +30,8 @@ pub const PREFETCH_ABOVE_BYTES: usize = 16 << 20;
 ///
 /// - Any-hit rays stop at their first occluder, often before the children fetched for them are
 ///   visited. Alone, on the dragon, ambient-occlusion rays gained 2-8% from outside but lost up to
-///   6% from inside, so they go without. In packets they gained 7-12% from outside and held even
-///   from inside (BENCHMARKS.md, "Prefetching in the packets' handed-over subtrees").
+///   6% from inside, so they go without. In packets they gained 7-15% from outside and moved by
+///   0.94-1.00 from inside (BENCHMARKS.md, "Prefetching in the packets' handed-over subtrees").
 /// - Coherence is judged on up to 32 pairs of neighbouring rays spread over the batch: where at
 ///   least a quarter of them point within about 18 degrees of each other (as neighbouring camera
 ///   rays do), the previous ray will have brought the nodes in. Two directions drawn at random over
