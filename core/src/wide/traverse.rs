@@ -139,11 +139,11 @@ impl<const W: usize> WideState<W> {
 }
 
 /// A postponed child as its slot holds it (the node's words, copied without a branch), decoded
-/// when popped. Decoding at the push cost a branch per pushed child on whether it is a leaf, which
-/// scattered rays mispredict: pushing the words instead gained 1.5-3% on the interiors
-/// (BENCHMARKS.md, "Prefetching in the packets' handed-over subtrees"). An empty slot, which no
-/// box test hits on an intact tree, is dropped at the pop before any event, so the events are
-/// those of never pushing it.
+/// when popped. Decoding it at the push took a branch per pushed child on whether it is an empty
+/// slot, a node or a leaf; pushing the words instead gained 1.5-3% on the interiors (BENCHMARKS.md,
+/// "The wide stack pushes a child's slot words"), likely mispredictions saved on scattered rays
+/// (there were no counters to tell). An empty slot, which no box test hits on an intact tree, is
+/// dropped at the pop before any event, so the events are those of never pushing it.
 #[derive(Clone, Copy, Debug)]
 struct Postponed {
     child: u32,
