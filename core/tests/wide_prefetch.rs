@@ -2,13 +2,14 @@
 //! only for incoherent rays over trees larger than the caches (any-hit rays only in packets).
 
 use glam::Vec3;
+use raytrail_core::bvh2::NodeRef;
 use raytrail_core::intersect::Watertight;
 use raytrail_core::method::{Collapse, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{
-    worth_prefetching, FastKernel, PrefetchingMemory, ReferenceKernel, WideBvh, PREFETCH_ABOVE_BYTES,
+    worth_prefetching, FastKernel, PrefetchingMemory, ReferenceKernel, WideBvh, WideMemory, PREFETCH_ABOVE_BYTES,
 };
 use raytrail_core::{Hit, Ray};
 
@@ -70,6 +71,20 @@ fn prefetching_changes_no_answer_and_no_event() {
     assert!(visited > 10_000, "only {visited} internal nodes visited");
 }
 
+/// Hits (as bits) and each ray's counters and nodes.
+type Traced = (Vec<(u32, u32, u32, u32)>, Vec<(Counters, Vec<NodeRef>)>);
+
+/// `rays` traced in packets over `mem`.
+fn in_packets<const W: usize, M: WideMemory<W>>(mem: &M, root: WideRoot, rays: &[Ray], query: Query) -> Traced {
+    let mut hits = vec![Hit::MISS; rays.len()];
+    let mut events = vec![(Counters::default(), Vec::new()); rays.len()];
+    let done = |i: usize, o: Both<Counters, Recorder>| events[i] = (o.0, o.1.nodes);
+    trace_wide_packets::<W, _, Watertight, FastKernel, ReferencePacketKernel, _>(
+        mem, root, rays, &mut hits, query, done,
+    );
+    (hits.iter().map(|h| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits())).collect(), events)
+}
+
 /// Packets (whose handed-over subtrees prefetch) on prefetching memory: the same answers and
 /// each ray's events as on plain memory.
 fn packets_same_as_plain<const W: usize>(wide: &WideBvh<W>, scale: f32) -> u64 {
@@ -77,28 +92,8 @@ fn packets_same_as_plain<const W: usize>(wide: &WideBvh<W>, scale: f32) -> u64 {
     let rays = scattered(1000, 11 + W as u64);
     let mut visited = 0;
     for query in [Query::Closest, Query::Any] {
-        let trace = |fetching: bool| {
-            let mut hits = vec![Hit::MISS; rays.len()];
-            let mut events = vec![(Counters::default(), Vec::new()); rays.len()];
-            let done = |i: usize, o: Both<Counters, Recorder>| events[i] = (o.0, o.1.nodes);
-            if fetching {
-                let mem = PrefetchingMemory(wide.memory());
-                trace_wide_packets::<W, _, Watertight, FastKernel, ReferencePacketKernel, _>(
-                    &mem, root, &rays, &mut hits, query, done,
-                );
-            } else {
-                trace_wide_packets::<W, _, Watertight, FastKernel, ReferencePacketKernel, _>(
-                    &wide.memory(),
-                    root,
-                    &rays,
-                    &mut hits,
-                    query,
-                    done,
-                );
-            }
-            (hits.iter().map(|h| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits())).collect::<Vec<_>>(), events)
-        };
-        let (plain, fetched) = (trace(false), trace(true));
+        let plain = in_packets(&wide.memory(), root, &rays, query);
+        let fetched = in_packets(&PrefetchingMemory(wide.memory()), root, &rays, query);
         assert_eq!(fetched, plain, "{query:?}");
         visited += plain.1.iter().map(|e| e.0.internal_nodes).sum::<u64>();
     }

@@ -67,11 +67,7 @@ impl<const W: usize> WideNode<W> {
     /// What child slot `i` refers to, or `None` for an empty slot (or a slot past `W`).
     #[inline(always)]
     pub fn child_ref(&self, i: usize) -> Option<WideChild> {
-        match (*self.child.get(i)?, self.count[i]) {
-            (EMPTY_CHILD, _) => None,
-            (n, 0) => Some(WideChild::Node(n)),
-            (first, count) => Some(WideChild::Leaf { first, count }),
-        }
+        WideChild::from_words(*self.child.get(i)?, self.count[i])
     }
 }
 
@@ -90,6 +86,17 @@ pub enum WideChild {
 }
 
 impl WideChild {
+    /// What a slot holding `child` and `count` refers to (see [`WideNode`]'s layout), or `None`
+    /// for an empty slot.
+    #[inline(always)]
+    pub fn from_words(child: u32, count: u32) -> Option<WideChild> {
+        match (child, count) {
+            (EMPTY_CHILD, _) => None,
+            (n, 0) => Some(WideChild::Node(n)),
+            (first, count) => Some(WideChild::Leaf { first, count }),
+        }
+    }
+
     /// The reference an observer records for this child: [`NodeRef::internal`] of the node index,
     /// or [`NodeRef::leaf`] of the first triangle position.
     #[inline(always)]

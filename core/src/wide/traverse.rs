@@ -4,7 +4,7 @@
 
 use super::kernel::{ChildHits, ChildKernel};
 use super::memory::WideMemory;
-use super::node::{WideChild, EMPTY_CHILD};
+use super::node::WideChild;
 use crate::intersect::{BlockHits, NoPair, RayContext, TriangleHit, TriangleTest, BLOCK};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
@@ -245,16 +245,10 @@ fn pop<O: Observer>(
         // SAFETY: entries below `len` were written by a push before `len` passed them (`len`
         // only grows by a push that writes the entry it passes), and `len` was above this one.
         let e = unsafe { stack[*len].assume_init() };
-        if e.child == EMPTY_CHILD {
-            continue;
-        }
+        let Some(child) = WideChild::from_words(e.child, e.count) else { continue };
         obs.backtrack(0, Backtrack::StackPop);
         if e.t_enter <= q.limit() + ctx.t_slack {
-            return Some(if e.count == 0 {
-                WideChild::Node(e.child)
-            } else {
-                WideChild::Leaf { first: e.child, count: e.count }
-            });
+            return Some(child);
         }
     }
     None
