@@ -14,11 +14,10 @@ use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideMemory, WideNode};
 use raytrail_core::{Hit, Ray};
 use std::arch::x86_64::{
-    _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_ps, _mm256_castps_si256,
-    _mm256_cmp_ps, _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps,
-    _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps,
-    _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps, _CMP_EQ_OQ,
-    _CMP_LE_OQ, _CMP_LT_OQ,
+    _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_castps_si256, _mm256_cmp_ps,
+    _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
+    _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256,
+    _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
 };
 
 /// Whether this processor runs the AVX2 path.
@@ -71,15 +70,15 @@ unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, t
         let splat = |x: f32| _mm256_set1_ps(x);
         let (mut t_enter, mut t_exit) = (splat(tmin), splat(tmax));
         for a in 0..3 {
+            // Planes picked by the direction's sign (`negative`, as the reference picks them) as
+            // an address rather than by a blend of both: the loads start the chain, and per-ray
+            // constant signs keep the choice predicted. 1.02 on the kitchen's inside camera and
+            // diffuse rays (BENCHMARKS.md, "Packets' box tests by ray").
+            let (np, fp) = if s.negative[a] { (&node.hi[a], &node.lo[a]) } else { (&node.lo[a], &node.hi[a]) };
             // SAFETY: eight floats inside arrays of `W`, from `lane <= W - 8`.
-            let (lo, hi) = unsafe {
-                (_mm256_loadu_ps(node.lo[a].as_ptr().add(lane)), _mm256_loadu_ps(node.hi[a].as_ptr().add(lane)))
-            };
-            // Planes picked by the sign bit of `1 / d`, which is `d`'s (`1 / ±0 = ±inf`), without a
-            // branch: scattered directions mispredicted one per axis, most of the cost of a ray
-            // that leaves the scene at its root.
+            let (near, far) =
+                unsafe { (_mm256_loadu_ps(np.as_ptr().add(lane)), _mm256_loadu_ps(fp.as_ptr().add(lane))) };
             let (oa, ia) = (splat(o[a]), splat(inv[a]));
-            let (near, far) = (_mm256_blendv_ps(lo, hi, ia), _mm256_blendv_ps(hi, lo, ia));
             let tn = _mm256_mul_ps(_mm256_sub_ps(near, oa), ia);
             let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, oa), ia), splat(FAR_PAD));
             t_enter = _mm256_max_ps(tn, t_enter);
