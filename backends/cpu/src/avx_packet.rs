@@ -19,9 +19,11 @@ use raytrail_core::wide::{ChildKernel, WideMemory, WideNode, EMPTY_CHILD};
 use raytrail_core::{Hit, Ray};
 use std::arch::x86_64::{
     __m256, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps256_ps128,
-    _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_extractf128_ps, _mm256_loadu_ps, _mm256_max_ps,
-    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setr_epi32,
-    _mm256_sub_ps, _mm_cvtss_f32, _mm_min_ps, _mm_min_ss, _mm_movehl_ps, _mm_shuffle_ps, _CMP_GT_OQ, _CMP_LE_OQ,
+    _mm256_castps_si256, _mm256_castsi256_ps, _mm256_castsi256_si128, _mm256_cmp_ps, _mm256_cmpeq_epi32,
+    _mm256_cvtepi32_epi64, _mm256_extractf128_ps, _mm256_extracti128_si256, _mm256_loadu_ps, _mm256_max_ps,
+    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_epi64x,
+    _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_ps,
+    _mm_cvtss_f32, _mm_min_ps, _mm_min_ss, _mm_movehl_ps, _mm_shuffle_ps, _CMP_GT_OQ, _CMP_LE_OQ,
 };
 
 /// The packet kernel of [`trace_batch`], used only there (and by the tests, after their own AVX2
@@ -92,8 +94,15 @@ unsafe fn reaching_avx<const N: usize>(key: f32, p: &PacketRays<N>, mask: u64) -
 #[target_feature(enable = "avx2")]
 #[inline]
 unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &PacketRays<N>, mask: u64) -> PacketHits<W> {
-    let mut out = PacketHits { key: [f32::INFINITY; W], rays: [0; W] };
     let mut todo = cull(node, p);
+    // By child, a register of eight rays per test, costs a test per child and register with a ray
+    // of `mask`; by ray, all eight children per test, a test per ray. Scattered packets (mixed
+    // signs: no cull; few rays per register) are cheaper by ray.
+    let registers = (0..N / 8).filter(|g| (mask >> (8 * g)) & 0xff != 0).count() as u32;
+    if mask.count_ones() < todo.count_ones() * registers {
+        return test_by_ray(node, p, mask);
+    }
+    let mut out = PacketHits { key: [f32::INFINITY; W], rays: [0; W] };
     // Bit k of a lane's own constant: the lanes of a register group picked by 8 bits of `mask`.
     let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
     let pad = _mm256_set1_ps(FAR_PAD);
@@ -131,6 +140,52 @@ unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &Packe
             out.key[c % W] = horizontal_min(key);
         }
     }
+    out
+}
+
+/// [`test_avx`] one ray at a time, all eight children per operation: each ray's test is the
+/// single-ray AVX test's (`crate::avx`), the child's key the least entry distance over the rays in
+/// lane order (`vminps(new, key)` keeps `key` on a tie, as the reference keeps the first).
+///
+/// # Safety
+/// As [`test_avx`].
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn test_by_ray<const W: usize, const N: usize>(
+    node: &WideNode<W>,
+    p: &PacketRays<N>,
+    mask: u64,
+) -> PacketHits<W> {
+    let s = _mm256_set1_ps;
+    let planes = |a: usize| (_mm256_loadu_ps(node.lo[a].as_ptr()), _mm256_loadu_ps(node.hi[a].as_ptr()));
+    let (x, y, z) = (planes(0), planes(1), planes(2));
+    let mut key = s(f32::INFINITY);
+    // Per slot, the rays that hit it as 64-bit lanes: slots 0-3, then 4-7.
+    let (mut low, mut high) = (_mm256_setzero_si256(), _mm256_setzero_si256());
+    let mut m = mask;
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let (mut t_enter, mut t_exit) = (s(p.t_lo[i]), s(p.t_hi[i]));
+        for (a, (lo, hi)) in [x, y, z].into_iter().enumerate() {
+            let (o, inv) = (s(p.origin[a][i]), s(p.inv_dir[a][i]));
+            let (near, far) = (_mm256_blendv_ps(lo, hi, inv), _mm256_blendv_ps(hi, lo, inv));
+            let tn = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
+            let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), s(FAR_PAD));
+            t_enter = _mm256_max_ps(tn, t_enter);
+            t_exit = _mm256_min_ps(tf, t_exit);
+        }
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, _mm256_add_ps(t_exit, s(p.slack[i])));
+        key = _mm256_min_ps(_mm256_blendv_ps(s(f32::INFINITY), t_enter, hit), key);
+        let hit = _mm256_castps_si256(hit);
+        let bit = _mm256_set1_epi64x(1i64 << i);
+        low = _mm256_or_si256(low, _mm256_and_si256(_mm256_cvtepi32_epi64(_mm256_castsi256_si128(hit)), bit));
+        high = _mm256_or_si256(high, _mm256_and_si256(_mm256_cvtepi32_epi64(_mm256_extracti128_si256::<1>(hit)), bit));
+    }
+    let mut out = PacketHits { key: [f32::INFINITY; W], rays: [0; W] };
+    _mm256_storeu_ps(out.key.as_mut_ptr(), key);
+    _mm256_storeu_si256(out.rays.as_mut_ptr().cast(), low);
+    _mm256_storeu_si256(out.rays.as_mut_ptr().add(4).cast(), high);
     out
 }
 
@@ -258,6 +313,14 @@ mod tests {
             let want = ReferencePacketKernel::test(&node, &p, mask);
             assert_eq!(got.rays, want.rays, "round {round}");
             assert_eq!(got.key, want.key, "round {round}");
+            // Both orders of the tests, whichever `test_avx` picked.
+            // SAFETY: AVX2 checked above.
+            let by_ray = unsafe { test_by_ray(&node, &p, mask) };
+            assert_eq!(
+                (by_ray.rays, by_ray.key.map(f32::to_bits)),
+                (want.rays, want.key.map(f32::to_bits)),
+                "round {round}"
+            );
             hits += want.rays.iter().filter(|&&r| r != 0).count();
             // SAFETY: as above.
             if unsafe { cull(&node, &p) } != (0..8).fold(0, |m, s| m | u32::from(node.child[s] != EMPTY_CHILD) << s) {
