@@ -4,6 +4,10 @@
 //! over the packet's ranges of origins and reciprocal directions: rounding is monotonic, so the
 //! interval's ends bound every ray's computed distances and the cull never drops a child that a
 //! ray's own test would keep. It only removes work: the answers are [`ReferencePacketKernel`]'s.
+//! Where the packet is sparse (few rays per register, and no cull for mixed directions, as for
+//! diffuse and ambient-occlusion rays), the tests run the other way round: each ray tests all eight
+//! children at once, as the single-ray test does, and its hits are merged into the children's masks
+//! and keys.
 //!
 //! [`ReferencePacketKernel`]: raytrail_core::wide::packet::ReferencePacketKernel
 
