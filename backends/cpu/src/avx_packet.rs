@@ -109,7 +109,6 @@ unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &Packe
     let mut out = PacketHits { key: [f32::INFINITY; W], rays: [0; W] };
     // Bit k of a lane's own constant: the lanes of a register group picked by 8 bits of `mask`.
     let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-    let pad = _mm256_set1_ps(FAR_PAD);
     let ld = |a: &[f32; N], at: usize| _mm256_loadu_ps(a.as_ptr().add(at));
     while todo != 0 {
         let c = todo.trailing_zeros() as usize;
@@ -125,12 +124,7 @@ unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &Packe
             let (mut t_enter, mut t_exit) = (ld(&p.t_lo, at), ld(&p.t_hi, at));
             for a in 0..3 {
                 let (lo, hi) = (_mm256_set1_ps(node.lo[a][c % W]), _mm256_set1_ps(node.hi[a][c % W]));
-                let (o, inv) = (ld(&p.origin[a], at), ld(&p.inv_dir[a], at));
-                let (near, far) = (_mm256_blendv_ps(lo, hi, inv), _mm256_blendv_ps(hi, lo, inv));
-                let tn = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
-                let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), pad);
-                t_enter = _mm256_max_ps(tn, t_enter);
-                t_exit = _mm256_min_ps(tf, t_exit);
+                (t_enter, t_exit) = slab_axis(lo, hi, ld(&p.origin[a], at), ld(&p.inv_dir[a], at), t_enter, t_exit);
             }
             let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, _mm256_add_ps(t_exit, ld(&p.slack, at)));
             let in_mask =
@@ -172,12 +166,7 @@ unsafe fn test_by_ray<const W: usize, const N: usize>(
         m &= m - 1;
         let (mut t_enter, mut t_exit) = (s(p.t_lo[i]), s(p.t_hi[i]));
         for (a, (lo, hi)) in [x, y, z].into_iter().enumerate() {
-            let (o, inv) = (s(p.origin[a][i]), s(p.inv_dir[a][i]));
-            let (near, far) = (_mm256_blendv_ps(lo, hi, inv), _mm256_blendv_ps(hi, lo, inv));
-            let tn = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
-            let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), s(FAR_PAD));
-            t_enter = _mm256_max_ps(tn, t_enter);
-            t_exit = _mm256_min_ps(tf, t_exit);
+            (t_enter, t_exit) = slab_axis(lo, hi, s(p.origin[a][i]), s(p.inv_dir[a][i]), t_enter, t_exit);
         }
         let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, _mm256_add_ps(t_exit, s(p.slack[i])));
         key = _mm256_min_ps(_mm256_blendv_ps(s(f32::INFINITY), t_enter, hit), key);
@@ -191,6 +180,29 @@ unsafe fn test_by_ray<const W: usize, const N: usize>(
     _mm256_storeu_si256(out.rays.as_mut_ptr().cast(), low);
     _mm256_storeu_si256(out.rays.as_mut_ptr().add(4).cast(), high);
     out
+}
+
+/// One axis of the slab test in eight lanes, each the single-ray test's operations in its order:
+/// near and far planes picked by the sign bit of `inv` (`1 / d`, whose sign is `d`'s), their
+/// distances (the far one padded) folded into the entry and exit distances. Both forms of
+/// [`test_avx`] test an axis with it.
+///
+/// # Safety
+/// The processor must support AVX.
+#[target_feature(enable = "avx")]
+#[inline]
+unsafe fn slab_axis(
+    lo: __m256,
+    hi: __m256,
+    o: __m256,
+    inv: __m256,
+    t_enter: __m256,
+    t_exit: __m256,
+) -> (__m256, __m256) {
+    let (near, far) = (_mm256_blendv_ps(lo, hi, inv), _mm256_blendv_ps(hi, lo, inv));
+    let tn = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
+    let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), _mm256_set1_ps(FAR_PAD));
+    (_mm256_max_ps(tn, t_enter), _mm256_min_ps(tf, t_exit))
 }
 
 /// The least lane of `v`.
