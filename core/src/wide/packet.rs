@@ -400,6 +400,11 @@ pub fn trace_wide_packets<
     let n = rays.len().min(hits.len());
     for (c, chunk) in rays[..n].chunks(PACKET_CHUNK).enumerate() {
         let base = c * PACKET_CHUNK;
+        // This closure holds a packet's whole traversal. The compiler inlines it into the
+        // caller's AVX2 loop only while it stays small: out of line it is not compiled for AVX2,
+        // and every kernel call in it stays a call (the instantiations that record enumerations
+        // are out of line already). Forcing it in cost camera rays 2-3%; watch its size instead
+        // (BENCHMARKS.md, "A quiet morning's Embree table, and two blocks per pass").
         for_each_packet(chunk, WIDE_PACKET, |idx| {
             let mut packet = [Ray { origin: [0.0; 3], tmin: 0.0, dir: [0.0; 3], tmax: 0.0 }; WIDE_PACKET];
             for (k, &i) in idx.iter().enumerate() {
