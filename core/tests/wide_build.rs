@@ -24,6 +24,16 @@ fn check<const W: usize>(bvh: &Bvh2, wide: &WideBvh<W>) -> Vec<u32> {
                 assert_eq!(count, b_count, "leaf {id} kept whole");
                 let (w, b) = (first as usize, b_first as usize);
                 assert_eq!(&wide.prims()[w..w + count as usize], &bvh.prim_order()[b..b + count as usize], "leaf {id}");
+                // The blocks hold the same triangles and ids, lane by lane, and empty lanes after.
+                for pos in w..(w + count as usize).next_multiple_of(4) {
+                    let block = &wide.blocks()[pos / 4];
+                    let lane = block.triangles.lane(pos % 4).map(glam::Vec3::from_array);
+                    if pos < w + count as usize {
+                        assert_eq!((block.prims[pos % 4], lane), (wide.prims()[pos], wide.triangles()[pos].v), "{pos}");
+                    } else {
+                        assert!(block.prims[pos % 4] == u32::MAX && lane[0].is_nan(), "empty lane {pos}");
+                    }
+                }
                 leaves.push(id);
             }
             WideChild::Node(n) => {

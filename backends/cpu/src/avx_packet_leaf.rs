@@ -238,12 +238,12 @@ mod tests {
     use crate::test_rng::Rng;
     use glam::Vec3;
     use raytrail_core::geometry::Triangle;
-    use raytrail_core::intersect::{NoPair, TriangleBlock, TriangleHit, Watertight};
+    use raytrail_core::intersect::{NoPair, TriangleHit, Watertight};
     use raytrail_core::method::Query;
     use raytrail_core::observe::{NoObserver, Observer};
     use raytrail_core::traverse::begin;
     use raytrail_core::wide::packet::{Lanes, PacketKernel, ReferencePacketKernel};
-    use raytrail_core::wide::{FastKernel, WideSliceMemory};
+    use raytrail_core::wide::{FastKernel, LeafBlock, WideSliceMemory};
     use raytrail_core::Ray;
 
     /// Each test and each accepted hit, in order.
@@ -276,9 +276,10 @@ mod tests {
             let pool: Vec<Vec3> = (0..5).map(|_| Vec3::new(rng.value(), rng.value(), rng.value())).collect();
             let mut pick = || pool[(rng.next() % 5) as usize];
             let triangles: Vec<Triangle> = (0..count).map(|_| Triangle::new(pick(), pick(), pick())).collect();
-            let blocks: Vec<TriangleBlock> = triangles.chunks(4).map(TriangleBlock::new).collect();
             let prims: Vec<u32> = (0..count as u32).map(|i| (i * 7 + round as u32) % 11).collect();
-            let mem = WideSliceMemory::<8> { nodes: &[], triangles: &triangles, blocks: &blocks, prims: &prims };
+            let blocks: Vec<LeafBlock> =
+                triangles.chunks(4).zip(prims.chunks(4)).map(|(t, p)| LeafBlock::new(t, p)).collect();
+            let mem = WideSliceMemory::<8> { nodes: &[], triangles: &triangles, blocks: &blocks };
             let query = if round % 3 == 0 { Query::Any } else { Query::Closest };
             let mut lanes: Lanes<Watertight, 32> = core::array::from_fn(|_| None);
             let mut mask = 0u64;

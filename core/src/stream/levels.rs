@@ -4,7 +4,7 @@
 
 use crate::bvh2::NodeRef;
 use crate::geometry::Triangle;
-use crate::intersect::TriangleBlock;
+use crate::wide::LeafBlock;
 use crate::wide::{WideBvh, WideChild, WideSliceMemory};
 use crate::{Aabb, Error};
 use alloc::vec;
@@ -78,7 +78,7 @@ pub struct LevelBvh {
     level_starts: Vec<u32>,
     canonical: Vec<u32>,
     triangles: Vec<Triangle>,
-    blocks: Vec<TriangleBlock>,
+    blocks: Vec<LeafBlock>,
     prims: Vec<u32>,
 }
 
@@ -181,14 +181,14 @@ impl LevelBvh {
     /// The triangles as the wide traversal's leaf test reads them (no wide nodes: this tree's
     /// nodes are read directly).
     pub fn leaf_memory(&self) -> WideSliceMemory<'_, 8> {
-        WideSliceMemory { nodes: &[], triangles: &self.triangles, blocks: &self.blocks, prims: &self.prims }
+        WideSliceMemory { nodes: &[], triangles: &self.triangles, blocks: &self.blocks }
     }
 
     /// Bytes of the nodes and triangle arrays.
     pub fn bytes(&self) -> usize {
         self.nodes.len() * core::mem::size_of::<LevelNode>()
             + self.triangles.len() * core::mem::size_of::<Triangle>()
-            + self.blocks.len() * core::mem::size_of::<TriangleBlock>()
+            + self.blocks.len() * core::mem::size_of::<LeafBlock>()
             + self.prims.len() * 4
     }
 

@@ -1,7 +1,8 @@
+use super::leaf_block::LeafBlock;
 use super::node::WideNode;
 use crate::bvh2::MemRead;
 use crate::geometry::Triangle;
-use crate::intersect::TriangleBlock;
+use crate::intersect::{TriangleBlock, BLOCK};
 use glam::Vec3;
 
 /// Every memory read a wide-BVH traversal makes goes through this trait (see
@@ -32,10 +33,8 @@ pub struct WideSliceMemory<'a, const W: usize> {
     pub nodes: &'a [WideNode<W>],
     /// Triangles in leaf order.
     pub triangles: &'a [Triangle],
-    /// The same triangles in blocks of four.
-    pub blocks: &'a [TriangleBlock],
-    /// Primitive id per triangle position.
-    pub prims: &'a [u32],
+    /// The same triangles in blocks of four, with their primitive ids.
+    pub blocks: &'a [LeafBlock],
 }
 
 impl<const W: usize> WideMemory<W> for WideSliceMemory<'_, W> {
@@ -45,7 +44,7 @@ impl<const W: usize> WideMemory<W> for WideSliceMemory<'_, W> {
     }
     #[inline(always)]
     fn prim(&self, pos: u32) -> u32 {
-        self.prims[pos as usize]
+        self.blocks[pos as usize / BLOCK].prims[pos as usize % BLOCK]
     }
     #[inline(always)]
     fn wide_triangle(&self, pos: u32) -> MemRead<'_, [Vec3; 3]> {
@@ -53,6 +52,6 @@ impl<const W: usize> WideMemory<W> for WideSliceMemory<'_, W> {
     }
     #[inline(always)]
     fn wide_block(&self, index: u32) -> MemRead<'_, TriangleBlock> {
-        MemRead::InPlace(&self.blocks[index as usize])
+        MemRead::InPlace(&self.blocks[index as usize].triangles)
     }
 }

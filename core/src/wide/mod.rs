@@ -6,6 +6,7 @@
 //!   binary leaf whole (needs `alloc`);
 //! - [`ChildKernel`]: testing and ordering a node's children, by the plain [`ReferenceKernel`] or
 //!   the [`FastKernel`] (SIMD box tests, the sorting network of [`network`]) that must equal it;
+//! - [`LeafBlock`]: four of a leaf's triangles and their primitive ids, as the CPU reads them;
 //! - [`WideMemory`]: what a traversal reads, in plain slices or with the hit children
 //!   prefetched ([`PrefetchingMemory`], for trees larger than the caches);
 //! - [`traverse`]: the state machine;
@@ -16,6 +17,7 @@
 
 mod kernel;
 pub mod keyed;
+mod leaf_block;
 mod memory;
 pub mod network;
 mod node;
@@ -29,6 +31,7 @@ pub mod traverse;
 mod tree;
 
 pub use kernel::{sort_keys, ChildHits, ChildKernel, FastKernel, ReferenceKernel};
+pub use leaf_block::LeafBlock;
 pub use memory::{WideMemory, WideSliceMemory};
 pub use node::{WideChild, WideNode, EMPTY_CHILD};
 pub use prefetch::{worth_prefetching, PrefetchingMemory, PREFETCH_ABOVE_BYTES};

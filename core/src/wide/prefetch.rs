@@ -9,6 +9,7 @@
 //! hints only cost instructions: shadow rays lost 12-15%. So the CPU backend prefetches only where
 //! [`worth_prefetching`] says so.
 
+use super::leaf_block::LeafBlock;
 use super::memory::{WideMemory, WideSliceMemory};
 use super::node::WideNode;
 use crate::bvh2::MemRead;
@@ -88,7 +89,7 @@ impl<const W: usize> WideMemory<W> for PrefetchingMemory<'_, W> {
         let (start, bytes) = if count == 0 {
             (self.0.nodes.as_ptr().wrapping_add(child).cast::<u8>(), core::mem::size_of::<WideNode<W>>())
         } else {
-            (self.0.blocks.as_ptr().wrapping_add(child / BLOCK).cast::<u8>(), core::mem::size_of::<TriangleBlock>())
+            (self.0.blocks.as_ptr().wrapping_add(child / BLOCK).cast::<u8>(), core::mem::size_of::<LeafBlock>())
         };
         // Every line the record touches, from the one its first byte is in (a 256-byte node that
         // does not start a line spans five).

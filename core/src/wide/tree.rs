@@ -1,8 +1,9 @@
+use super::leaf_block::LeafBlock;
 use super::node::{WideChild, WideNode};
 use super::optimal::OptimalCuts;
 use crate::bvh2::{Bvh2, NodeKind, NodeRef};
 use crate::geometry::Triangle;
-use crate::intersect::{TriangleBlock, BLOCK};
+use crate::intersect::BLOCK;
 use crate::method::Collapse;
 use crate::Error;
 use alloc::vec::Vec;
@@ -34,7 +35,7 @@ pub struct WideBvh<const W: usize> {
     nodes: Vec<WideNode<W>>,
     root: WideChild,
     triangles: Vec<Triangle>,
-    blocks: Vec<TriangleBlock>,
+    blocks: Vec<LeafBlock>,
     prims: Vec<u32>,
     node_ids: Vec<u32>,
     leaf_ids: Vec<u32>,
@@ -75,7 +76,8 @@ impl<const W: usize> WideBvh<W> {
         let root = b.child(0, 0)?;
         let mut out = b.out;
         out.root = root;
-        out.blocks = out.triangles.chunks(BLOCK).map(TriangleBlock::new).collect();
+        out.blocks =
+            out.triangles.chunks(BLOCK).zip(out.prims.chunks(BLOCK)).map(|(t, p)| LeafBlock::new(t, p)).collect();
         out.stats.nodes = out.nodes.len();
         out.stats.node_bytes = out.nodes.len() * core::mem::size_of::<WideNode<W>>();
         Ok(out)
@@ -96,19 +98,15 @@ impl<const W: usize> WideBvh<W> {
         &self.triangles
     }
 
-    /// The triangles in blocks of four: block `i` holds positions `4 i .. 4 i + 3`.
-    pub fn blocks(&self) -> &[TriangleBlock] {
+    /// The triangles in blocks of four with their primitive ids: block `i` holds positions
+    /// `4 i .. 4 i + 3`.
+    pub fn blocks(&self) -> &[LeafBlock] {
         &self.blocks
     }
 
     /// The tree as [`WideMemory`](super::WideMemory) for traversal in place.
     pub fn memory(&self) -> super::WideSliceMemory<'_, W> {
-        super::WideSliceMemory {
-            nodes: &self.nodes,
-            triangles: &self.triangles,
-            blocks: &self.blocks,
-            prims: &self.prims,
-        }
+        super::WideSliceMemory { nodes: &self.nodes, triangles: &self.triangles, blocks: &self.blocks }
     }
 
     /// The primitive id of each triangle position (`u32::MAX` in the gaps between leaves).
@@ -122,7 +120,8 @@ impl<const W: usize> WideBvh<W> {
     }
 
     /// Bytes of everything the traversal reads or reports from: nodes, triangles in leaf order,
-    /// their blocks of four, primitive ids and the canonical ids of nodes and leaves.
+    /// their blocks of four with their ids, primitive ids by position (as the GPU and the embedded
+    /// tables read them) and the canonical ids of nodes and leaves.
     pub fn bytes(&self) -> usize {
         core::mem::size_of_val(self.nodes.as_slice())
             + core::mem::size_of_val(self.triangles.as_slice())
