@@ -1,7 +1,10 @@
 //! The AVX2 path of the wide traversal, chosen at run time: an 8-wide node's boxes in one 256-bit
 //! operation per step, three or more hit children ordered by rank, and the whole batch loop
 //! compiled for AVX2 (so the 4-wide SSE code and the triangle tests get its three-operand encoding
-//! too). Every answer and every order is the reference kernel's bit for bit; the tests below hold
+//! too) and for the bit instructions every AVX2 processor has (BMI1, BMI2, LZCNT, POPCNT): without
+//! them a mask's `count_ones` was a multiply sequence on the path to every node's order, and each
+//! `trailing_zeros` a branchy `bsf` (1.01-1.03 on most ray sets; BENCHMARKS.md, "Triangle blocks
+//! that carry their primitive ids"). Every answer and every order is the reference kernel's bit for bit; the tests below hold
 //! them to that on adversarial values.
 
 use raytrail_core::intersect::{SlabRay, TriangleTest, FAR_PAD};
@@ -20,9 +23,14 @@ use std::arch::x86_64::{
     _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
 };
 
-/// Whether this processor runs the AVX2 path.
+/// Whether this processor runs the AVX2 path: AVX2 and the bit instructions the path is compiled
+/// for with it (every AVX2 processor has them; the check costs nothing per ray).
 pub(crate) fn available() -> bool {
     std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("bmi1")
+        && std::arch::is_x86_feature_detected!("bmi2")
+        && std::arch::is_x86_feature_detected!("lzcnt")
+        && std::arch::is_x86_feature_detected!("popcnt")
 }
 
 /// The fast kernel with 8-wide nodes tested in one AVX operation per plane and ordered by
@@ -37,7 +45,7 @@ impl ChildKernel for AvxKernel {
     #[inline(always)]
     fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
         if W % 8 == 0 {
-            // SAFETY: only `trace_batch` uses this kernel, and only on a processor with AVX2.
+            // SAFETY: only `trace_batch` uses this kernel, and only on a processor that runs the AVX2 path.
             unsafe { test_avx(node, slab, tmin, tmax) }
         } else {
             FastKernel::test(node, slab, tmin, tmax)
@@ -47,7 +55,7 @@ impl ChildKernel for AvxKernel {
     #[inline(always)]
     fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
         if W == 8 && hits.mask.count_ones() > 2 {
-            // SAFETY: only `trace_batch` uses this kernel, and only on a processor with AVX2.
+            // SAFETY: only `trace_batch` uses this kernel, and only on a processor that runs the AVX2 path.
             unsafe { order_by_rank(hits, order) }
         } else {
             FastKernel::order(hits, order)
@@ -102,8 +110,8 @@ unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, t
 /// network compiled to two branches per compare-and-swap here.
 ///
 /// # Safety
-/// The processor must support AVX2.
-#[target_feature(enable = "avx2")]
+/// The processor must run the AVX2 path ([`crate::avx::available`]).
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn order_by_rank<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
     if W != 8 {
@@ -136,8 +144,8 @@ unsafe fn order_by_rank<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W
 /// [`trace_wide_batch`] with [`AvxKernel`], compiled for AVX2.
 ///
 /// # Safety
-/// The processor must support AVX2 ([`available`]).
-#[target_feature(enable = "avx2")]
+/// The processor must run the AVX2 path ([`available`]).
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
     mem: &M,
     root: WideRoot,
@@ -153,8 +161,8 @@ pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: T
 /// AVX2.
 ///
 /// # Safety
-/// The processor must support AVX2 ([`available`]).
-#[target_feature(enable = "avx2")]
+/// The processor must run the AVX2 path ([`available`]).
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 pub(crate) unsafe fn trace_keyed_batch<
     const W: usize,
     K: Key,

@@ -39,7 +39,7 @@ impl PacketKernel for AvxPacketKernel {
     #[inline(always)]
     fn test<const W: usize, const N: usize>(node: &WideNode<W>, rays: &PacketRays<N>, mask: u64) -> PacketHits<W> {
         if W == 8 && N % 8 == 0 {
-            // SAFETY: only `trace_batch` uses this kernel, and only on a processor with AVX2.
+            // SAFETY: only `trace_batch` uses this kernel, and only on a processor that runs the AVX2 path.
             unsafe { test_avx(node, rays, mask) }
         } else {
             ReferencePacketKernel::test(node, rays, mask)
@@ -80,8 +80,8 @@ impl PacketKernel for AvxPacketKernel {
 }
 
 /// # Safety
-/// The processor must support AVX2; `N` must be a multiple of 8.
-#[target_feature(enable = "avx2")]
+/// The processor must run the AVX2 path ([`crate::avx::available`]); `N` must be a multiple of 8.
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn reaching_avx<const N: usize>(key: f32, p: &PacketRays<N>, mask: u64) -> u64 {
     let k = _mm256_set1_ps(key);
@@ -94,8 +94,8 @@ unsafe fn reaching_avx<const N: usize>(key: f32, p: &PacketRays<N>, mask: u64) -
 }
 
 /// # Safety
-/// The processor must support AVX2; `W` must be 8 and `N` a multiple of 8.
-#[target_feature(enable = "avx2")]
+/// The processor must run the AVX2 path ([`crate::avx::available`]); `W` must be 8 and `N` a multiple of 8.
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &PacketRays<N>, mask: u64) -> PacketHits<W> {
     let mut todo = cull(node, p);
@@ -147,7 +147,7 @@ unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &Packe
 ///
 /// # Safety
 /// As [`test_avx`].
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn test_by_ray<const W: usize, const N: usize>(
     node: &WideNode<W>,
@@ -206,7 +206,7 @@ unsafe fn slab_axis(
 }
 
 /// The least lane of `v`.
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn horizontal_min(v: __m256) -> f32 {
     let h = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
@@ -220,7 +220,7 @@ unsafe fn horizontal_min(v: __m256) -> f32 {
 ///
 /// # Safety
 /// As [`test_avx`].
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn cull<const W: usize, const N: usize>(node: &WideNode<W>, p: &PacketRays<N>) -> u32 {
     let present = (0..W).fold(0u32, |m, s| m | u32::from(node.child[s] != EMPTY_CHILD) << s);
@@ -255,8 +255,8 @@ unsafe fn cull<const W: usize, const N: usize>(node: &WideNode<W>, p: &PacketRay
 /// [`trace_wide_packets`] with the AVX2 child kernel and packet kernel, compiled for AVX2.
 ///
 /// # Safety
-/// The processor must support AVX2 ([`crate::avx::available`]).
-#[target_feature(enable = "avx2")]
+/// The processor must run the AVX2 path ([`crate::avx::available`]).
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer + Default>(
     mem: &M,
     root: WideRoot,

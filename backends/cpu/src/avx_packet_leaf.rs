@@ -53,8 +53,8 @@ struct TriangleLanes {
 /// register in lane order, where `T` is the watertight test; `None` (nothing done) otherwise.
 ///
 /// # Safety
-/// The processor must support AVX2.
-#[target_feature(enable = "avx2")]
+/// The processor must run the AVX2 path ([`crate::avx::available`]).
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 pub(crate) unsafe fn leaf<const W: usize, const N: usize, M, T, O>(
     mem: &M,
@@ -143,8 +143,8 @@ where
 /// One triangle (its nine floats from `v`) against the rays of `r`.
 ///
 /// # Safety
-/// The processor must support AVX2; `v` must point to nine readable floats.
-#[target_feature(enable = "avx2")]
+/// The processor must run the AVX2 path ([`crate::avx::available`]); `v` must point to nine readable floats.
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn triangle(r: &RayLanes, v: *const f32) -> TriangleLanes {
     let splat = |x: f32| _mm256_set1_ps(x);

@@ -5,8 +5,8 @@ use bytemuck::{Pod, Zeroable};
 /// them: the id of a lane the ray hits is read from the lines the block's test has just loaded,
 /// where a separate array of ids costs a load from elsewhere per hit (on the dragon, a likely
 /// miss). Aligned to 32 bytes, a record spans three cache lines wherever it lies (a 144-byte block
-/// at 16-byte alignment spans three or four). 1.02-1.03 on diffuse rays of Sponza and the dragon
-/// (BENCHMARKS.md, "Triangle blocks with their primitive ids").
+/// at 16-byte alignment spans three or four). 1.02-1.06 on the dragon's rays, 0.99-1.03 on the
+/// interiors' (BENCHMARKS.md, "Triangle blocks that carry their primitive ids").
 ///
 /// Byte layout (`repr(C)`, 160 bytes, no padding): `triangles` (144 bytes, [`TriangleBlock`]'s
 /// layout), then `prims` (16 bytes). Lanes without a triangle hold NaN vertices and id
@@ -27,8 +27,8 @@ unsafe impl Zeroable for LeafBlock {}
 unsafe impl Pod for LeafBlock {}
 
 impl LeafBlock {
-    /// Blocks of the triangles `triangles` with primitive ids `prims` (by position; positions past
-    /// either slice become empty lanes).
+    /// A block of up to four `triangles` with their primitive ids `prims`, by lane: lanes past
+    /// `triangles` are empty, and a triangle without an id gets `u32::MAX`.
     pub fn new(triangles: &[crate::geometry::Triangle], prims: &[u32]) -> LeafBlock {
         LeafBlock {
             triangles: TriangleBlock::new(triangles),
