@@ -4,8 +4,8 @@
 //! too) and for the bit instructions every AVX2 processor has (BMI1, BMI2, LZCNT, POPCNT): without
 //! them a mask's `count_ones` was a multiply sequence on the path to every node's order, and each
 //! `trailing_zeros` a branchy `bsf` (1.01-1.03 on most ray sets; BENCHMARKS.md, "Triangle blocks
-//! that carry their primitive ids"). Every answer and every order is the reference kernel's bit for bit; the tests below hold
-//! them to that on adversarial values.
+//! that carry their primitive ids"). Every answer and every order is the reference kernel's bit
+//! for bit; the tests below hold them to that on adversarial values.
 
 use raytrail_core::intersect::{SlabRay, TriangleTest, FAR_PAD};
 use raytrail_core::key::Key;
@@ -45,7 +45,7 @@ impl ChildKernel for AvxKernel {
     #[inline(always)]
     fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
         if W % 8 == 0 {
-            // SAFETY: only `trace_batch` uses this kernel, and only on a processor that runs the AVX2 path.
+            // SAFETY: only `trace_batch` uses this kernel, and only where the AVX2 path runs.
             unsafe { test_avx(node, slab, tmin, tmax) }
         } else {
             FastKernel::test(node, slab, tmin, tmax)
@@ -55,7 +55,7 @@ impl ChildKernel for AvxKernel {
     #[inline(always)]
     fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
         if W == 8 && hits.mask.count_ones() > 2 {
-            // SAFETY: only `trace_batch` uses this kernel, and only on a processor that runs the AVX2 path.
+            // SAFETY: only `trace_batch` uses this kernel, and only where the AVX2 path runs.
             unsafe { order_by_rank(hits, order) }
         } else {
             FastKernel::order(hits, order)

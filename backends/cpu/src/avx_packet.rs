@@ -39,7 +39,7 @@ impl PacketKernel for AvxPacketKernel {
     #[inline(always)]
     fn test<const W: usize, const N: usize>(node: &WideNode<W>, rays: &PacketRays<N>, mask: u64) -> PacketHits<W> {
         if W == 8 && N % 8 == 0 {
-            // SAFETY: only `trace_batch` uses this kernel, and only on a processor that runs the AVX2 path.
+            // SAFETY: only `trace_batch` uses this kernel, and only where the AVX2 path runs.
             unsafe { test_avx(node, rays, mask) }
         } else {
             ReferencePacketKernel::test(node, rays, mask)

@@ -4,8 +4,7 @@
 
 use crate::bvh2::NodeRef;
 use crate::geometry::Triangle;
-use crate::wide::LeafBlock;
-use crate::wide::{WideBvh, WideChild, WideSliceMemory};
+use crate::wide::{LeafBlock, WideBvh, WideChild, WideSliceMemory};
 use crate::{Aabb, Error};
 use alloc::vec;
 use alloc::vec::Vec;
