@@ -183,6 +183,9 @@ pub const WIDE: Source = Source { name: "wide.wgsl", text: include_str!("wide.wg
 /// `wide_packet.wgsl`.
 pub const WIDE_PACKET: Source = Source { name: "wide_packet.wgsl", text: include_str!("wide_packet.wgsl") };
 
+/// `wide_ray_stream.wgsl`.
+pub const WIDE_RAY_STREAM: Source = Source { name: "wide_ray_stream.wgsl", text: include_str!("wide_ray_stream.wgsl") };
+
 /// `wide_stack.wgsl`.
 pub const WIDE_STACK: Source = Source { name: "wide_stack.wgsl", text: include_str!("wide_stack.wgsl") };
 
@@ -243,6 +246,7 @@ pub const ALL: &[Source] = &[
     TRIANGLE_WATERTIGHT,
     WIDE,
     WIDE_PACKET,
+    WIDE_RAY_STREAM,
     WIDE_STACK,
     WIDE_TRAIL,
 ];

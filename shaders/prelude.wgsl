@@ -56,6 +56,12 @@ struct Params {
     // kd: scene box.
     kd_lo: vec4<f32>,
     kd_hi: vec4<f32>,
+    // The stream kernel (wide_ray_stream.wgsl): this round of the batch (0: the streams start),
+    // and the steps a stream takes in one round before it saves its state for the next.
+    stream_round: u32,
+    stream_steps: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;

@@ -7,13 +7,14 @@ use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use raytrail_core::kd::traverse::packets::packets;
 use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, RestartPolicy, PACKET_WIDTH};
 use raytrail_core::key::{Key, KeyWidth};
-use raytrail_core::method::{KdMethod, Method, Query, StreamMethod};
+use raytrail_core::method::{KdMethod, Method, Query, StreamMethod, WideMethod};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::stream::{trace_stream_with, FrustumCull, Serial};
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::keyed::WideKeyedMemory;
 use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
+use raytrail_core::wide::ray_stream::trace_wide_streams;
 use raytrail_core::wide::trail::trace_wide_trail_ray;
 use raytrail_core::wide::traverse::{trace_wide_ray, WideRoot};
 use raytrail_core::wide::{ReferenceKernel, WideSliceMemory, WideTree};
@@ -88,8 +89,8 @@ impl SerialBackend {
             Method::Wide(m) => {
                 let root = scene.wide_root(m)?;
                 match scene.wide_tree(m)? {
-                    WideTree::Four(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query, m.packets())),
-                    WideTree::Eight(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query, m.packets())),
+                    WideTree::Four(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query, m)),
+                    WideTree::Eight(t) => Ok(Self::wide::<_, T>(&t.memory(), root, rays, query, m)),
                 }
             }
             other => Err(Error::Unsupported { method: other.name(), by: "the serial reference backend" }),
@@ -99,27 +100,29 @@ impl SerialBackend {
 
 impl SerialBackend {
     /// Wide trees with the reference kernel (one child box at a time, an insertion sort): the
-    /// scalar traversal every fast path's enumeration must equal. With `packets`, in the packets
-    /// of the grouping, each ray's box tests one child at a time ([`ReferencePacketKernel`]).
+    /// scalar traversal every fast path's enumeration must equal. A packet method in the packets
+    /// of the grouping, each ray's box tests one child at a time ([`ReferencePacketKernel`]); a
+    /// stream method in its streams.
     fn wide<const W: usize, T: TriangleTest>(
         mem: &WideSliceMemory<'_, W>,
         root: WideRoot,
         rays: &[Ray],
         query: Query,
-        packets: bool,
+        method: WideMethod,
     ) -> Vec<Traced> {
-        if packets {
-            let mut out: Vec<Traced> = (0..rays.len()).map(|_| (Hit::MISS, Default::default())).collect();
+        if method.shares_walks() {
             let mut hits = vec![Hit::MISS; rays.len()];
             let mut observers = Vec::with_capacity(rays.len());
-            trace_wide_packets::<W, _, T, ReferenceKernel, ReferencePacketKernel, Both<Counters, Recorder>>(
-                mem,
-                root,
-                rays,
-                &mut hits,
-                query,
-                |i, o| observers.push((i, o)),
-            );
+            let done = |i, o| observers.push((i, o));
+            type Obs = Both<Counters, Recorder>;
+            if method.streams() {
+                trace_wide_streams::<W, _, T, ReferenceKernel, Obs>(mem, root, rays, &mut hits, query, done);
+            } else {
+                trace_wide_packets::<W, _, T, ReferenceKernel, ReferencePacketKernel, Obs>(
+                    mem, root, rays, &mut hits, query, done,
+                );
+            }
+            let mut out: Vec<Traced> = (0..rays.len()).map(|_| (Hit::MISS, Default::default())).collect();
             for (i, o) in observers {
                 out[i] = (hits[i], o);
             }

@@ -14,20 +14,11 @@ use raytrail_core::wide::{
 use raytrail_core::{Hit, Ray};
 
 mod common;
-use common::{wide_soup, Rng};
+use common::{scattered_rays, wide_soup};
 
-/// Rays from all around the soup in every direction (incoherent), some axis-parallel.
+/// Rays from all around the soup ([`scattered_rays`]).
 fn scattered(n: usize, seed: u64) -> Vec<Ray> {
-    let mut r = Rng(seed);
-    (0..n)
-        .map(|i| {
-            let mut d = r.v() - 0.5;
-            if i % 7 == 0 {
-                d = Vec3::new(0.0, d.y, 0.0);
-            }
-            Ray::new(r.v() * 14.0 - 2.0, d, 0.0, if i % 3 == 0 { 5.0 } else { f32::INFINITY })
-        })
-        .collect()
+    scattered_rays(n, seed, None)
 }
 
 /// A pinhole camera's rays in pixel order (coherent).

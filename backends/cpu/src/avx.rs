@@ -12,15 +12,17 @@ use raytrail_core::key::Key;
 use raytrail_core::method::Query;
 use raytrail_core::observe::Observer;
 use raytrail_core::wide::keyed::WideKeyedMemory;
+use raytrail_core::wide::ray_stream::trace_wide_streams;
 use raytrail_core::wide::trail::trace_wide_trail_batch;
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideMemory, WideNode};
 use raytrail_core::{Hit, Ray};
 use std::arch::x86_64::{
-    _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_castps_si256, _mm256_cmp_ps,
-    _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
-    _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256,
-    _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
+    _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_ps, _mm256_castps_si256,
+    _mm256_cmp_ps, _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps,
+    _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps,
+    _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps, _CMP_EQ_OQ,
+    _CMP_LE_OQ, _CMP_LT_OQ,
 };
 
 /// Whether this processor runs the AVX2 path: AVX2 and the bit instructions the path is compiled
@@ -49,6 +51,25 @@ impl ChildKernel for AvxKernel {
             unsafe { test_avx(node, slab, tmin, tmax) }
         } else {
             FastKernel::test(node, slab, tmin, tmax)
+        }
+    }
+
+    #[inline(always)]
+    fn stream_node<const W: usize>(
+        node: &WideNode<W>,
+        live: &[u32],
+        slab: &[SlabRay],
+        interval: &[(f32, f32)],
+        masks: &mut [u32],
+        t_enter: &mut [[f32; W]],
+        keys: &mut [f32; W],
+        counts: &mut [u32; W],
+    ) {
+        if W == 8 {
+            // SAFETY: only `trace_batch` and `trace_streams` use this kernel, where AVX2 runs.
+            unsafe { stream_node_avx(node, live, slab, interval, masks, t_enter, keys, counts) }
+        } else {
+            FastKernel::stream_node(node, live, slab, interval, masks, t_enter, keys, counts)
         }
     }
 
@@ -100,6 +121,57 @@ unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, t
         lane += 8;
     }
     out
+}
+
+/// [`ChildKernel::stream_node`] for eight children: the node's planes loaded once, each ray's
+/// test the single-ray test's operations in its order (near and far planes picked by the sign bit
+/// of `1 / d`, which is `d`'s, as the packet kernel picks them: no branch on a sign that changes
+/// from ray to ray), the keys folded by `vminps(t, key)` (a tie keeps the key) and the counts by a
+/// subtraction, both in registers over the list.
+///
+/// # Safety
+/// The processor must run the AVX2 path ([`available`]); `W` must be 8; `masks` and `t_enter`
+/// must hold an entry per ray of `live`, and every ray of `live` must index `slab` and `interval`.
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
+#[inline]
+#[allow(clippy::too_many_arguments)]
+unsafe fn stream_node_avx<const W: usize>(
+    node: &WideNode<W>,
+    live: &[u32],
+    slab: &[SlabRay],
+    interval: &[(f32, f32)],
+    masks: &mut [u32],
+    t_enter: &mut [[f32; W]],
+    keys: &mut [f32; W],
+    counts: &mut [u32; W],
+) {
+    let ld = |a: &[f32; W]| _mm256_loadu_ps(a.as_ptr());
+    let planes =
+        [(ld(&node.lo[0]), ld(&node.hi[0])), (ld(&node.lo[1]), ld(&node.hi[1])), (ld(&node.lo[2]), ld(&node.hi[2]))];
+    let splat = _mm256_set1_ps;
+    let (mut key, mut count) = (ld(keys), _mm256_loadu_si256(counts.as_ptr().cast()));
+    for (k, &r) in live.iter().enumerate() {
+        let s = slab.get_unchecked(r as usize);
+        let (lo, hi) = *interval.get_unchecked(r as usize);
+        let (o, inv) = (s.origin.to_array(), s.inv_dir.to_array());
+        let (mut te, mut tx) = (splat(lo), splat(hi));
+        for (a, &(l, h)) in planes.iter().enumerate() {
+            let (oa, ia) = (splat(o[a]), splat(inv[a]));
+            let (near, far) = (_mm256_blendv_ps(l, h, ia), _mm256_blendv_ps(h, l, ia));
+            let tn = _mm256_mul_ps(_mm256_sub_ps(near, oa), ia);
+            let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, oa), ia), splat(FAR_PAD));
+            te = _mm256_max_ps(tn, te);
+            tx = _mm256_min_ps(tf, tx);
+        }
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(te, _mm256_add_ps(tx, splat(s.slack)));
+        let kept = _mm256_blendv_ps(splat(f32::INFINITY), te, hit);
+        _mm256_storeu_ps(t_enter.get_unchecked_mut(k).as_mut_ptr(), kept);
+        key = _mm256_min_ps(kept, key);
+        count = _mm256_sub_epi32(count, _mm256_castps_si256(hit));
+        *masks.get_unchecked_mut(k) = _mm256_movemask_ps(hit) as u32;
+    }
+    _mm256_storeu_ps(keys.as_mut_ptr(), key);
+    _mm256_storeu_si256(counts.as_mut_ptr().cast(), count);
 }
 
 /// Three or more hit children of an 8-wide node ordered without a branch: each child's rank is
@@ -155,6 +227,27 @@ pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: T
     obs: &mut O,
 ) {
     trace_wide_batch::<W, M, T, AvxKernel, O>(mem, root, rays, hits, query, obs);
+}
+
+/// [`trace_wide_streams`] (streams of rays) with [`AvxKernel`], compiled for AVX2.
+///
+/// # Safety
+/// The processor must run the AVX2 path ([`available`]).
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
+pub(crate) unsafe fn trace_streams<
+    const W: usize,
+    M: WideMemory<W> + ?Sized,
+    T: TriangleTest,
+    O: Observer + Default,
+>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    done: impl FnMut(usize, O),
+) {
+    trace_wide_streams::<W, M, T, AvxKernel, O>(mem, root, rays, hits, query, done);
 }
 
 /// [`trace_wide_trail_batch`] (the keyed, stackless traversal) with [`AvxKernel`], compiled for

@@ -5,14 +5,22 @@ use raytrail_core::method::Method;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
+use raytrail_core::wide::STREAM_RAYS;
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
 /// Rays per parallel task: large enough to amortize scheduling, small enough to balance load; the
-/// packet grouping's chunk, so that packets never span two tasks.
-const CHUNK: usize = PACKET_CHUNK;
+/// packet grouping's chunk, so that packets never span two tasks; for a stream method, one stream,
+/// so that each task traces a whole one.
+fn chunk_rays(method: Method) -> usize {
+    if method.wide().is_some_and(|m| m.streams()) {
+        STREAM_RAYS
+    } else {
+        PACKET_CHUNK
+    }
+}
 
 /// The rayon backend. Uses rayon's global pool unless built with a thread count.
 #[derive(Debug, Default)]
@@ -106,7 +114,9 @@ impl CpuBackend {
         scene.0.check_prepared(opts.method)?;
         if let Method::Stream(m) = opts.method {
             // The batch as a whole: its stages are the parallel part.
-            if framing == Framing::Check && self.install(|| rays.par_chunks(CHUNK).any(|c| scene.0.needs_framing(c))) {
+            if framing == Framing::Check
+                && self.install(|| rays.par_chunks(PACKET_CHUNK).any(|c| scene.0.needs_framing(c)))
+            {
                 return Ok(None);
             }
             let start = Instant::now();
@@ -121,19 +131,20 @@ impl CpuBackend {
             return Ok(Some(report));
         }
         let unframed = AtomicBool::new(false);
+        let chunk = chunk_rays(opts.method);
         let mut enumerations: Vec<Vec<u32>> =
             if opts.record == Record::Enumerations { vec![Vec::new(); rays.len()] } else { Vec::new() };
         let start = Instant::now();
         let counters = self.install(|| {
             let record = opts.record == Record::Enumerations;
             let enum_chunks: Vec<&mut [Vec<u32>]> =
-                if record { enumerations.chunks_mut(CHUNK).collect() } else { Vec::new() };
+                if record { enumerations.chunks_mut(chunk).collect() } else { Vec::new() };
             let mut enum_chunks = enum_chunks.into_iter().map(Some).collect::<Vec<_>>();
             if !record {
-                enum_chunks.resize_with(rays.len().div_ceil(CHUNK), || None);
+                enum_chunks.resize_with(rays.len().div_ceil(chunk), || None);
             }
-            rays.par_chunks(CHUNK)
-                .zip(hits.par_chunks_mut(CHUNK))
+            rays.par_chunks(chunk)
+                .zip(hits.par_chunks_mut(chunk))
                 .zip(enum_chunks.into_par_iter())
                 .map(|((rays, hits), e)| {
                     if framing == Framing::Check && scene.0.needs_framing(rays) {

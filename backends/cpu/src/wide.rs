@@ -1,6 +1,7 @@
 //! The wide-BVH methods' loop for one chunk, monomorphized per width x memory x triangle test x
 //! recording, with the fast child kernel (SIMD box tests, the sorting network), in the AVX2 loop
-//! where the processor has AVX2; the packet method's loop over the chunk's packets likewise. The
+//! where the processor has AVX2; the packet method's loop over the chunk's packets and the stream
+//! method's over its streams likewise. The
 //! memory prefetches hit children where that pays (a large tree, incoherent rays, any-hit ones only
 //! in packets: [`worth_prefetching`]; in the packet loop, only the subtrees handed over to single
 //! rays prefetch).
@@ -14,6 +15,7 @@ use raytrail_core::observe::{Both, Counters, NoObserver, Observer, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
 use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
+use raytrail_core::wide::ray_stream::trace_wide_streams;
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{worth_prefetching, FastKernel, PrefetchingMemory, WideMemory, WideSliceMemory, WideTree};
 use raytrail_core::{Error, Hit, Ray};
@@ -66,30 +68,28 @@ impl WideRun<'_> {
         mem: &M,
         chunk: Chunk<'_>,
     ) -> Result<Counters, Error> {
+        let (root, query) = (self.root, self.opts.query);
         if self.method.packets() {
-            return self.run_packets::<W, M, T>(mem, chunk);
+            return self.run_shared(chunk, &Packets::<W, M, T> { mem, root, query, test: PhantomData });
         }
-        let stack = StackBatch::<W, M, T> { mem, root: self.root, query: self.opts.query, test: PhantomData };
+        if self.method.streams() {
+            return self.run_shared(chunk, &Streams::<W, M, T> { mem, root, query, test: PhantomData });
+        }
+        let stack = StackBatch::<W, M, T> { mem, root, query, test: PhantomData };
         record_rays(self.scene, self.method, self.opts.record, chunk, &stack)
     }
 
-    /// [`WideRun::run`] in wide packets.
-    fn run_packets<const W: usize, M: WideMemory<W>, T: TriangleTest>(
-        &self,
-        mem: &M,
-        chunk: Chunk<'_>,
-    ) -> Result<Counters, Error> {
-        let (root, query) = (self.root, self.opts.query);
+    /// [`WideRun::run`] for a method whose rays share walks of the tree (packets, streams): each
+    /// ray's observer comes back from the walk.
+    fn run_shared(&self, chunk: Chunk<'_>, walks: &impl SharedWalks) -> Result<Counters, Error> {
         let mut counters = Counters::default();
         match self.opts.record {
-            Record::Nothing => packets::<W, M, T, NoObserver>(mem, root, chunk.rays, chunk.hits, query, |_, _| {}),
-            Record::Counters => {
-                packets::<W, M, T, Counters>(mem, root, chunk.rays, chunk.hits, query, |_, c| counters.add(&c))
-            }
+            Record::Nothing => walks.trace::<NoObserver>(chunk.rays, chunk.hits, &mut |_, _| {}),
+            Record::Counters => walks.trace::<Counters>(chunk.rays, chunk.hits, &mut |_, c| counters.add(&c)),
             Record::Enumerations => {
                 let mut failed = None;
                 let slots = &mut *chunk.enumerations;
-                packets::<W, M, T, Both<Counters, Recorder>>(mem, root, chunk.rays, chunk.hits, query, |i, o| {
+                walks.trace::<Both<Counters, Recorder>>(chunk.rays, chunk.hits, &mut |i, o| {
                     counters.add(&o.0);
                     match self.scene.canonical_ids(Method::Wide(self.method), o.1.nodes.iter().copied()) {
                         Ok(ids) => slots[i] = ids,
@@ -103,6 +103,40 @@ impl WideRun<'_> {
         }
         counters.rays = chunk.rays.len() as u64;
         Ok(counters)
+    }
+}
+
+/// A loop over a chunk whose rays share walks of the tree, generic over what observes each ray.
+trait SharedWalks {
+    /// Traces `rays` into `hits`, handing each ray's index and observer to `done`.
+    fn trace<O: Observer + Default>(&self, rays: &[Ray], hits: &mut [Hit], done: &mut impl FnMut(usize, O));
+}
+
+/// The packet loop ([`packets`]).
+struct Packets<'m, const W: usize, M, T> {
+    mem: &'m M,
+    root: WideRoot,
+    query: Query,
+    test: PhantomData<T>,
+}
+
+impl<const W: usize, M: WideMemory<W>, T: TriangleTest> SharedWalks for Packets<'_, W, M, T> {
+    fn trace<O: Observer + Default>(&self, rays: &[Ray], hits: &mut [Hit], done: &mut impl FnMut(usize, O)) {
+        packets::<W, M, T, O>(self.mem, self.root, rays, hits, self.query, done);
+    }
+}
+
+/// The stream loop ([`streams`]).
+struct Streams<'m, const W: usize, M, T> {
+    mem: &'m M,
+    root: WideRoot,
+    query: Query,
+    test: PhantomData<T>,
+}
+
+impl<const W: usize, M: WideMemory<W>, T: TriangleTest> SharedWalks for Streams<'_, W, M, T> {
+    fn trace<O: Observer + Default>(&self, rays: &[Ray], hits: &mut [Hit], done: &mut impl FnMut(usize, O)) {
+        streams::<W, M, T, O>(self.mem, self.root, rays, hits, self.query, done);
     }
 }
 
@@ -172,6 +206,26 @@ fn packets<const W: usize, M: WideMemory<W>, T: TriangleTest, O: Observer + Defa
         return;
     }
     trace_wide_packets::<W, M, T, FastKernel, ReferencePacketKernel, O>(mem, root, rays, hits, query, done);
+}
+
+/// The stream loop: the AVX2 one where the processor has AVX2, else the baseline fast kernel.
+/// The chunk must start a stream ([`STREAM_RAYS`](raytrail_core::wide::STREAM_RAYS)).
+#[inline(always)]
+fn streams<const W: usize, M: WideMemory<W>, T: TriangleTest, O: Observer + Default>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    done: impl FnMut(usize, O),
+) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::avx::available() {
+        // SAFETY: the processor has AVX2 (checked just above).
+        unsafe { crate::avx::trace_streams::<W, M, T, O>(mem, root, rays, hits, query, done) };
+        return;
+    }
+    trace_wide_streams::<W, M, T, FastKernel, O>(mem, root, rays, hits, query, done);
 }
 
 /// The batch loop: the AVX2 one where the processor has AVX2, else the baseline fast kernel (SSE

@@ -3,10 +3,10 @@
 //! the oldest one is waited for, so that the device works on one batch while the host fills the
 //! next and empties the previous.
 
-use crate::config::{Dispatch, GpuConfig, CPU_ADAPTER_ROUNDS, MAX_PERSISTENT_ROUNDS};
+use crate::config::{Dispatch, GpuConfig, CPU_ADAPTER_ROUNDS, CPU_ADAPTER_STREAM_STEPS, MAX_PERSISTENT_ROUNDS};
 use crate::device::{device_error, Gpu};
 use crate::params::Params;
-use crate::workspace::{SceneBindings, Slot, Workspace, HIT_BYTES};
+use crate::workspace::{SceneBindings, Slot, SlotNeeds, Workspace, HIT_BYTES};
 use bytemuck::Pod;
 use raytrail_core::method::Method;
 use raytrail_core::{Error, Hit, Ray};
@@ -22,9 +22,22 @@ pub(crate) struct Launch<'a> {
     pub scene: SceneBindings<'a>,
     /// Per-scene parameters; the batch fills in its own counts.
     pub params: Params,
-    /// Rays per work item (1, or the packet width).
+    /// Rays per work item (1, the packet width, or the stream's rays).
     pub rays_per_item: usize,
+    /// Kernel scratch bytes per work item (the stream kernel's lists), beyond the item counter.
+    pub scratch_per_item: u64,
     pub config: GpuConfig,
+}
+
+impl Launch<'_> {
+    /// Kernel scratch bytes for a batch of `rays` rays: the unfinished count's 16 bytes, then
+    /// each item's.
+    pub fn scratch_bytes(&self, rays: usize) -> u64 {
+        match self.scratch_per_item {
+            0 => 0,
+            bytes => 16 + rays.div_ceil(self.rays_per_item.max(1)) as u64 * bytes,
+        }
+    }
 }
 
 /// What a stream of batches returns besides the hits.
@@ -42,9 +55,14 @@ pub(crate) fn batch_rays(gpu: &Gpu, launch: &Launch<'_>) -> usize {
     let stride = launch.params.record_stride.max(1) as usize;
     let binding = (l.max_storage_buffer_binding_size.min(l.max_buffer_size) as usize).max(64);
     let by_binding = (binding / 32).min(binding / (4 * stride));
-    let by_dispatch = l.max_compute_workgroups_per_dimension as usize * launch.config.workgroup_size as usize * 1024;
+    // Whole items of scratch within one binding.
     let per_item = launch.rays_per_item.max(1);
-    let n = launch.config.batch_rays.min(by_binding).min(by_dispatch).max(per_item);
+    let by_scratch = match launch.scratch_per_item as usize {
+        0 => usize::MAX,
+        bytes => (binding / bytes).max(1) * per_item,
+    };
+    let by_dispatch = l.max_compute_workgroups_per_dimension as usize * launch.config.workgroup_size as usize * 1024;
+    let n = launch.config.batch_rays.min(by_binding).min(by_scratch).min(by_dispatch).max(per_item);
     n - n % per_item
 }
 
@@ -132,6 +150,9 @@ fn take<T: Pod>(buffer: &wgpu::Buffer, out: &mut [T]) -> Result<(), Error> {
 pub(crate) enum Stamps<'q> {
     /// Its slot's two, around the pass (where the slot has queries).
     Slot,
+    /// Of its slot's two, the first before the pass if `begin`, the second after it if `end`
+    /// (timestamps around several rounds).
+    SlotPart { begin: bool, end: bool },
     /// Into `queries`: index 0 before the pass if `begin`, index 1 after it if `end` (timestamps
     /// around many passes).
     Around { queries: &'q wgpu::QuerySet, begin: bool, end: bool },
@@ -147,7 +168,7 @@ pub(crate) fn encode(
     stamps: Stamps<'_>,
 ) {
     if let Dispatch::Persistent { .. } = launch.config.dispatch {
-        enc.clear_buffer(&slot.counter, 0, None);
+        enc.clear_buffer(&slot.scratch, 0, None);
     }
     let bind = slot.bind_group(gpu, launch.bind_layout, launch.method, &launch.scene).clone();
     let timestamp_writes = match stamps {
@@ -156,6 +177,13 @@ pub(crate) fn encode(
             beginning_of_pass_write_index: Some(0),
             end_of_pass_write_index: Some(1),
         }),
+        Stamps::SlotPart { begin, end } => {
+            slot.timer.as_ref().filter(|_| begin || end).map(|t| wgpu::ComputePassTimestampWrites {
+                query_set: &t.queries,
+                beginning_of_pass_write_index: begin.then_some(0),
+                end_of_pass_write_index: end.then_some(1),
+            })
+        }
         Stamps::Around { queries, begin, end } => (begin || end).then_some(wgpu::ComputePassTimestampWrites {
             query_set: queries,
             beginning_of_pass_write_index: begin.then_some(0),
@@ -195,7 +223,7 @@ pub(crate) fn run(
                 .map_err(|_| device_error("the read-back callback never ran"))?
                 .map_err(|e| device_error(format!("mapping a read-back buffer: {e}")))?;
         }
-        let slot = ws.slot(gpu, p.slot, 0, 0, max_bytes);
+        let slot = ws.slot(gpu, p.slot, SlotNeeds::default(), max_bytes);
         // Each buffer read is unmapped; what a failure leaves mapped is unmapped before the slot's
         // next batch (`Slot::unmap_leftovers`).
         take(&slot.hit_back, &mut hits[p.first..p.first + p.rays])?;
@@ -226,12 +254,18 @@ pub(crate) fn run(
             let items = n.div_ceil(launch.rays_per_item);
             let d = grid(gpu, launch, items)?;
             let params = d.params(launch.params, n);
-            let slot = ws.slot(gpu, slot_index, n, n * stride, max_bytes);
+            let need = SlotNeeds { rays: n, record_words: n * stride, scratch_bytes: launch.scratch_bytes(n) };
+            let slot = ws.slot(gpu, slot_index, need, max_bytes);
             slot.unmap_leftovers();
             gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&params));
             gpu.queue.write_buffer(&slot.rays, 0, bytemuck::cast_slice(chunk));
+            if launch.scratch_per_item > 0 {
+                rounds(gpu, launch, slot, params, (d.x, d.y))?;
+            }
             let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
-            encode(gpu, &mut enc, launch, slot, (d.x, d.y), Stamps::Slot);
+            if launch.scratch_per_item == 0 {
+                encode(gpu, &mut enc, launch, slot, (d.x, d.y), Stamps::Slot);
+            }
             let hit_bytes = n as u64 * HIT_BYTES;
             enc.copy_buffer_to_buffer(&slot.hits, 0, &slot.hit_back, 0, hit_bytes);
             let record_bytes = (n * stride * 4) as u64;
@@ -261,6 +295,29 @@ pub(crate) fn run(
         Ok(())
     })??;
     Ok(StreamOut { records, gpu_seconds })
+}
+
+/// The stream kernel's rounds over one batch (shaders/wide_ray_stream.wgsl): dispatched, each on
+/// its own and waited for, until no stream is left unfinished; the slot's timestamps span them
+/// all. On a GPU one round does it; a CPU adapter takes [`CPU_ADAPTER_STREAM_STEPS`] steps a
+/// round. Every round takes a step at least, and a stream at most nine per node it visits (the
+/// visit, its copy and up to seven pops), so `9 * max_steps` steps bound the rounds.
+fn rounds(gpu: &Gpu, launch: &Launch<'_>, slot: &mut Slot, params: Params, dims: (u32, u32)) -> Result<(), Error> {
+    let steps = if gpu.info.device_type == wgpu::DeviceType::Cpu { CPU_ADAPTER_STREAM_STEPS } else { u32::MAX };
+    let most = 9 * u64::from(params.max_steps) / u64::from(steps) + 2;
+    for round in 0..most {
+        let p = Params { stream_round: round.min(u64::from(u32::MAX)) as u32, stream_steps: steps, ..params };
+        gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&p));
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("round") });
+        enc.clear_buffer(&slot.scratch, 0, Some(16));
+        encode(gpu, &mut enc, launch, slot, dims, Stamps::SlotPart { begin: round == 0, end: true });
+        enc.copy_buffer_to_buffer(&slot.scratch, 0, &slot.scratch_back, 0, 16);
+        gpu.queue.submit([enc.finish()]);
+        if read::<u32>(gpu, &slot.scratch_back, 1)?[0] == 0 {
+            return Ok(());
+        }
+    }
+    Err(device_error(format!("the stream kernel left streams unfinished after {most} rounds")))
 }
 
 /// Reads `count` values of `T` from the start of the read-back `buffer` (for one-off reads such as

@@ -50,6 +50,7 @@ const DISPATCH_GRID: Part = part!(DISPATCH_GRID);
 const DISPATCH_PERSISTENT: Part = part!(DISPATCH_PERSISTENT);
 const WIDE: Part = part!(WIDE);
 const WIDE_PACKET: Part = part!(WIDE_PACKET);
+const WIDE_RAY_STREAM: Part = part!(WIDE_RAY_STREAM);
 const WIDE_STACK: Part = part!(WIDE_STACK);
 const WIDE_TRAIL: Part = part!(WIDE_TRAIL);
 
@@ -118,8 +119,9 @@ impl Variant {
         if let Method::Stream(_) = self.method {
             return Ok(parts);
         }
-        // The wide packet kernel has its own entry point (a packet to a workgroup).
-        if self.method.wide().is_some_and(|m| m.packets()) {
+        // The wide packet and stream kernels have their own entry points (a packet or a stream to
+        // a workgroup).
+        if self.method.wide().is_some_and(|m| m.shares_walks()) {
             return Ok(parts);
         }
         // The kd packet kernel defines its own work items (one packet each).
@@ -157,6 +159,7 @@ impl Variant {
             Method::Kd(KdMethod::Packet) => &[KD_COMMON, KD_PACKET],
             // The single-ray loop too: a packet hands thin subtrees to its rays.
             Method::Wide(m) if m.packets() => &[WIDE, WIDE_STACK, WIDE_PACKET],
+            Method::Wide(m) if m.streams() => &[WIDE, WIDE_RAY_STREAM],
             Method::Wide(m) if m.keyed() => &[WIDE, keys, HASH, WIDE_TRAIL],
             Method::Wide(_) => &[WIDE, WIDE_STACK],
             // Its stages are kernels of their own (crate::stream); this is the one that traces.
@@ -231,6 +234,7 @@ pub(crate) fn constants_header(method: Method) -> String {
          const PACKET_WIDTH: u32 = {PACKET_WIDTH}u;\n\
          const WIDE_PACKET: u32 = {wide_packet}u;\n\
          const WIDE_HAND_OVER: u32 = {hand_over}u;\n\
+         const WIDE_STREAM: u32 = {wide_stream}u;\n\
          // Children per wide node, and the node keys' bits per level (its log2).\n\
          const WIDE_W: u32 = {wide_width}u;\n\
          const WK_BITS: u32 = {wide_bits}u;\n",
@@ -240,9 +244,16 @@ pub(crate) fn constants_header(method: Method) -> String {
         REFINE_SCALE.to_bits(),
         wide_packet = raytrail_core::wide::packet::WIDE_PACKET,
         hand_over = raytrail_core::wide::packet::HAND_OVER,
+        wide_stream = raytrail_core::wide::STREAM_RAYS,
         wide_bits = wide_width.trailing_zeros(),
     )
 }
+
+// The stream kernel's invocations own 32 rays each, at most 256 of them (wgpu's default limit).
+const _: () = assert!(
+    raytrail_core::wide::STREAM_RAYS % 32 == 0 && raytrail_core::wide::STREAM_RAYS / 32 <= 256,
+    "streams of whole words, one per invocation"
+);
 
 // The packet kernel's ray masks are one `u32`.
 const _: () = assert!(raytrail_core::wide::packet::WIDE_PACKET <= 32, "wide packets of more than 32 rays");

@@ -38,7 +38,7 @@ impl Dispatch {
     pub fn for_method(self, method: Method) -> Dispatch {
         match self {
             Dispatch::ByMethod => match method.wide() {
-                Some(m) if !m.keyed() && !m.packets() => Dispatch::PERSISTENT,
+                Some(m) if !m.keyed() && !m.shares_walks() => Dispatch::PERSISTENT,
                 _ => Dispatch::Grid,
             },
             concrete => concrete,
@@ -88,6 +88,12 @@ pub const MAX_PERSISTENT_ROUNDS: usize = 4096;
 /// and stopped in the middle of one, leaving hits unwritten (seen on the conformance suite's
 /// adversarial rays with kd-packet). Two rounds still run the fetch loop.
 pub const CPU_ADAPTER_ROUNDS: usize = 2;
+
+/// The stream kernel's steps per round on a CPU adapter (shaders/wide_ray_stream.wgsl): a step's
+/// loops run at most 32 rays x (a leaf of 8 triangles, or 8 children, and the loops over them),
+/// about 800 iterations, so 48 steps stay well within lavapipe's 65,535 (see
+/// [`CPU_ADAPTER_ROUNDS`]).
+pub const CPU_ADAPTER_STREAM_STEPS: u32 = 48;
 
 /// Default rays per batch: big enough to fill a large GPU many times over, small enough that a
 /// trace of millions of rays is several batches, so that transfers overlap with kernels.

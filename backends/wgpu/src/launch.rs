@@ -15,7 +15,8 @@ use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{KdMethod, Method};
 use raytrail_core::trace::{Record, TraceOptions};
 use raytrail_core::wide::packet::WIDE_PACKET;
-use raytrail_core::wide::WideChild;
+use raytrail_core::wide::traverse::WIDE_STACK;
+use raytrail_core::wide::{WideChild, STREAM_RAYS};
 use raytrail_core::{Error, Ray};
 
 /// The kernel variant for `options` on `scene` under `config`.
@@ -42,10 +43,11 @@ fn keys_for(scene: &WgpuScene, method: Method) -> KeyWidth {
 }
 
 /// `config` as `method` runs under it: the dispatch resolved ([`Dispatch::for_method`]); the wide
-/// packet kernel is a packet to a workgroup, so its work items are packets handed out one
-/// workgroup each (`grid` counts workgroups as items per workgroup size), on the grid.
+/// packet and stream kernels take a packet or a stream to a workgroup, so their work items are
+/// packets or streams handed out one workgroup each (`grid` counts workgroups as items per
+/// workgroup size), on the grid.
 fn for_method(method: Method, config: GpuConfig) -> GpuConfig {
-    if is_wide_packet(method) {
+    if shares_walks(method) {
         GpuConfig { workgroup_size: 1, dispatch: Dispatch::Grid, ..config }
     } else {
         GpuConfig { dispatch: config.dispatch.for_method(method), ..config }
@@ -55,6 +57,20 @@ fn for_method(method: Method, config: GpuConfig) -> GpuConfig {
 fn is_wide_packet(method: Method) -> bool {
     method.wide().is_some_and(|m| m.packets())
 }
+
+fn is_wide_stream(method: Method) -> bool {
+    method.wide().is_some_and(|m| m.streams())
+}
+
+/// Whether `method`'s kernel takes a packet or a stream of rays to a workgroup.
+fn shares_walks(method: Method) -> bool {
+    method.wide().is_some_and(|m| m.shares_walks())
+}
+
+/// The stream kernel's scratch per stream (shaders/wide_ray_stream.wgsl, `WS_REGION`): a set of
+/// one bit per ray for every stack entry, then the state a round saves (eight words, two per stack
+/// entry, the current set).
+const STREAM_SCRATCH_BYTES: u64 = 4 * (WIDE_STACK * STREAM_RAYS / 32 + 8 + 2 * WIDE_STACK + STREAM_RAYS / 32) as u64;
 
 /// Record words per ray for `options` with room for `cap` node events.
 pub(crate) fn record_stride(options: &TraceOptions, cap: usize) -> usize {
@@ -141,10 +157,21 @@ pub(crate) fn launch<'a>(
     let rays_per_item = match options.method {
         Method::Kd(KdMethod::Packet) => PACKET_WIDTH,
         m if is_wide_packet(m) => WIDE_PACKET,
+        m if is_wide_stream(m) => STREAM_RAYS,
         _ => 1,
     };
+    let scratch_per_item = if is_wide_stream(options.method) { STREAM_SCRATCH_BYTES } else { 0 };
     let config = for_method(options.method, config);
-    Ok(Launch { pipeline, bind_layout, method: options.method, scene: scene_bindings, params, rays_per_item, config })
+    Ok(Launch {
+        pipeline,
+        bind_layout,
+        method: options.method,
+        scene: scene_bindings,
+        params,
+        rays_per_item,
+        scratch_per_item,
+        config,
+    })
 }
 
 /// A packet kernel's rays, grouped as the core groups them (every backend alike): slot `s` holds

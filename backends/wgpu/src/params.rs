@@ -2,7 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Per-batch and per-scene constants, laid out as the WGSL struct (96 bytes).
+/// Per-batch and per-scene constants, laid out as the WGSL struct (112 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub(crate) struct Params {
@@ -26,12 +26,17 @@ pub(crate) struct Params {
     pub persistent_rounds: u32,
     pub kd_lo: [f32; 4],
     pub kd_hi: [f32; 4],
+    /// The stream kernel: which round of a batch this is (0: the streams start), and the steps
+    /// a stream takes in one round before it saves its state for the next.
+    pub stream_round: u32,
+    pub stream_steps: u32,
+    pub pad: [u32; 2],
 }
 
 #[cfg(test)]
 mod tests {
     #[test]
     fn params_match_the_wgsl_size() {
-        assert_eq!(core::mem::size_of::<super::Params>(), 96);
+        assert_eq!(core::mem::size_of::<super::Params>(), 112);
     }
 }

@@ -54,7 +54,8 @@ fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntr
 impl Pipelines {
     pub fn new(gpu: &Gpu) -> Pipelines {
         // shaders/prelude.wgsl: parameters, rays (read), hits (write), three scene buffers (read),
-        // records (write); shaders/dispatch_persistent.wgsl: the item counter (read and write).
+        // records (write); the kernel scratch (read and write): shaders/dispatch_persistent.wgsl's
+        // item counter, shaders/wide_ray_stream.wgsl's lists.
         let (read, write) = (Some(true), Some(false));
         let (bind_layout, layout) =
             buffer_layout(gpu, "raytrail", &[None, read, write, read, read, read, write, write]);

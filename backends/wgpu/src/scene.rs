@@ -255,7 +255,7 @@ impl WgpuScene {
     pub(crate) fn wide_for(&self, method: WideMethod) -> Option<&WideBuffer> {
         match method {
             WideMethod::Bvh4 | WideMethod::Bvh4Hash => self.wide4.as_ref(),
-            WideMethod::Bvh8 | WideMethod::Bvh8Packet => self.wide8.as_ref(),
+            WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream => self.wide8.as_ref(),
             WideMethod::Bvh4Naive => self.wide4_naive.as_ref(),
             WideMethod::Bvh8Sah => self.wide8_sah.as_ref(),
         }

@@ -8,7 +8,7 @@ use crate::batch::{self, Launch, Stamps};
 use crate::device::{device_error, Gpu};
 use crate::launch::{self, Arranged};
 use crate::scene::WgpuScene;
-use crate::workspace::Workspace;
+use crate::workspace::{SlotNeeds, Workspace};
 use raytrail_core::method::Method;
 use raytrail_core::trace::{Record, Trace, TraceOptions};
 use raytrail_core::{Error, Hit, Ray};
@@ -83,7 +83,8 @@ struct Uploaded {
 impl WgpuBackend {
     /// Times the kernel of `options` over `rays` at steady clocks (see the module's text);
     /// [`Error::Device`] where the adapter has no timestamp queries. The stream method is timed
-    /// by whole traces (its stages' timestamps), since its passes depend on each other's sizes.
+    /// by whole traces (its stages' timestamps), since its passes depend on each other's sizes;
+    /// so is `bvh8-stream`, whose streams may take rounds the host waits for.
     /// Records nothing: `options.record` is ignored.
     pub fn time_kernel(
         &self,
@@ -102,7 +103,7 @@ impl WgpuBackend {
             return Err(Error::InvalidParameter { name: "rays", why: "timing needs at least one ray" });
         }
         let options = options.record(Record::Nothing);
-        if let Method::Stream(_) = options.method {
+        if matches!(options.method, Method::Stream(_)) || options.method.wide().is_some_and(|m| m.streams()) {
             return self.time_whole_traces(scene, rays, &options, plan);
         }
         let pipeline = self.pipelines.get(&self.gpu, &launch::variant(scene, &options, &self.config))?;
@@ -140,8 +141,8 @@ impl WgpuBackend {
         })?
     }
 
-    /// [`WgpuBackend::time_kernel`] for the stream method: whole traces, each sample the sum of
-    /// its stages' timestamps.
+    /// [`WgpuBackend::time_kernel`] for the stream methods: whole traces, each sample the sum of
+    /// its stages' (or rounds') timestamps.
     fn time_whole_traces(
         &self,
         scene: &WgpuScene,
@@ -180,7 +181,8 @@ fn upload(gpu: &Gpu, ws: &mut Workspace, launch: &Launch<'_>, rays: &[Ray]) -> R
         let n = chunk.len();
         let d = batch::grid(gpu, launch, n.div_ceil(launch.rays_per_item))?;
         let params = d.params(launch.params, n);
-        let slot = ws.slot(gpu, b, n, 0, max_bytes);
+        let need = SlotNeeds { rays: n, record_words: 0, scratch_bytes: launch.scratch_bytes(n) };
+        let slot = ws.slot(gpu, b, need, max_bytes);
         gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&params));
         gpu.queue.write_buffer(&slot.rays, 0, bytemuck::cast_slice(chunk));
         batches.push((b, (d.x, d.y)));
@@ -202,7 +204,7 @@ fn passes(
     let last = count * up.batches.len() - 1;
     for k in 0..count * up.batches.len() {
         let (slot_index, (x, y)) = up.batches[k % up.batches.len()];
-        let slot = ws.slot(gpu, slot_index, 0, 0, max_bytes);
+        let slot = ws.slot(gpu, slot_index, SlotNeeds::default(), max_bytes);
         let stamps = Stamps::Around { queries, begin: k == 0, end: k == last };
         batch::encode(gpu, &mut enc, launch, slot, (x, y), stamps);
     }

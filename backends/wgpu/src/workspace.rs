@@ -17,16 +17,21 @@ pub(crate) struct Slot {
     pub rays: wgpu::Buffer,
     pub hits: wgpu::Buffer,
     pub records: wgpu::Buffer,
-    /// The persistent kernels' item counter, zeroed before every dispatch.
-    pub counter: wgpu::Buffer,
+    /// The kernel's scratch: the persistent kernels' item counter (zeroed before every
+    /// dispatch), or the stream kernel's lists.
+    pub scratch: wgpu::Buffer,
     pub hit_back: wgpu::Buffer,
     pub record_back: wgpu::Buffer,
+    /// The scratch's first 16 bytes read back (the stream kernel's unfinished streams).
+    pub scratch_back: wgpu::Buffer,
     /// Two timestamps around the batch's pass, resolved and read back with the hits.
     pub timer: Option<Timer>,
     /// Rays the buffers hold.
     pub ray_capacity: usize,
     /// Record words the buffers hold.
     pub record_capacity: usize,
+    /// Bytes the scratch holds.
+    pub scratch_capacity: u64,
     /// Bind groups by method (a method binds the same scene buffers every time).
     binds: HashMap<Method, wgpu::BindGroup>,
     /// Read-back buffers mapped or being mapped and not yet read: bit 0 hits, 1 records, 2 the
@@ -48,6 +53,14 @@ pub(crate) struct SceneBindings<'a> {
     pub kd: &'a wgpu::Buffer,
 }
 
+/// What a batch needs of its slot: rays, record words, scratch bytes.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SlotNeeds {
+    pub rays: usize,
+    pub record_words: usize,
+    pub scratch_bytes: u64,
+}
+
 /// The ring of slots of one scene, and how many buffers it has ever created.
 #[derive(Default)]
 pub(crate) struct Workspace {
@@ -66,23 +79,31 @@ impl Workspace {
         self.created
     }
 
-    /// Slot `i`, with room for `rays` rays and `record_words` record words; made or grown as
-    /// needed. `max_bytes` is the device's largest binding.
-    pub fn slot(&mut self, gpu: &Gpu, i: usize, rays: usize, record_words: usize, max_bytes: u64) -> &mut Slot {
+    /// Slot `i`, with room for what `need` says; made or grown as needed. `max_bytes` is the
+    /// device's largest binding.
+    pub fn slot(&mut self, gpu: &Gpu, i: usize, need: SlotNeeds, max_bytes: u64) -> &mut Slot {
         while self.slots.len() <= i {
-            let slot = self.make(gpu, 0, 0, max_bytes);
+            let slot = self.make(gpu, SlotNeeds::default(), max_bytes);
             self.slots.push(slot);
         }
         let s = &self.slots[i];
-        if s.ray_capacity < rays || s.record_capacity < record_words {
-            let (r, w) = (s.ray_capacity.max(rays), s.record_capacity.max(record_words));
-            self.slots[i] = self.make(gpu, r, w, max_bytes);
+        if s.ray_capacity < need.rays
+            || s.record_capacity < need.record_words
+            || s.scratch_capacity < need.scratch_bytes
+        {
+            let grown = SlotNeeds {
+                rays: s.ray_capacity.max(need.rays),
+                record_words: s.record_capacity.max(need.record_words),
+                scratch_bytes: s.scratch_capacity.max(need.scratch_bytes),
+            };
+            self.slots[i] = self.make(gpu, grown, max_bytes);
         }
         &mut self.slots[i]
     }
 
-    /// A slot for `rays` rays and `record_words` words, capacities rounded up within `max_bytes`.
-    fn make(&mut self, gpu: &Gpu, rays: usize, record_words: usize, max_bytes: u64) -> Slot {
+    /// A slot for what `need` says, capacities rounded up within `max_bytes`.
+    fn make(&mut self, gpu: &Gpu, need: SlotNeeds, max_bytes: u64) -> Slot {
+        let SlotNeeds { rays, record_words, scratch_bytes } = need;
         // Rounded up for growth, but not past the largest binding unless the batch itself needs it
         // (batches are sized to fit), and never empty.
         let cap = |n: usize, unit: u64| (grown(n) as u64 * unit).min(max_bytes).max(n as u64 * unit).max(16);
@@ -96,9 +117,12 @@ impl Workspace {
         let rays_buf = self.buffer(gpu, "rays", ray_bytes, U::STORAGE | U::COPY_DST);
         let hits = self.buffer(gpu, "hits", hit_bytes, U::STORAGE | U::COPY_SRC | U::COPY_DST);
         let records = self.buffer(gpu, "records", record_bytes, U::STORAGE | U::COPY_SRC);
-        let counter = self.buffer(gpu, "item counter", 16, U::STORAGE | U::COPY_DST);
+        // Not rounded up: the stream kernel's lists are large, and a batch's size rarely changes.
+        let scratch_capacity = scratch_bytes.max(16);
+        let scratch = self.buffer(gpu, "kernel scratch", scratch_capacity, U::STORAGE | U::COPY_DST | U::COPY_SRC);
         let hit_back = self.buffer(gpu, "hits read-back", hit_bytes, U::MAP_READ | U::COPY_DST);
         let record_back = self.buffer(gpu, "records read-back", record_bytes, U::MAP_READ | U::COPY_DST);
+        let scratch_back = self.buffer(gpu, "scratch read-back", 16, U::MAP_READ | U::COPY_DST);
         let timer = gpu.timestamps.then(|| {
             self.created += 1;
             Timer {
@@ -116,12 +140,14 @@ impl Workspace {
             rays: rays_buf,
             hits,
             records,
-            counter,
+            scratch,
             hit_back,
             record_back,
+            scratch_back,
             timer,
             ray_capacity,
             record_capacity,
+            scratch_capacity,
             binds: HashMap::new(),
             mapped: 0,
         }
@@ -154,7 +180,7 @@ impl Slot {
         method: Method,
         scene: &SceneBindings<'_>,
     ) -> &wgpu::BindGroup {
-        let Slot { uniform, rays, hits, records, counter, binds, .. } = self;
+        let Slot { uniform, rays, hits, records, scratch, binds, .. } = self;
         binds.entry(method).or_insert_with(|| {
             fn e(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
                 wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
@@ -170,7 +196,7 @@ impl Slot {
                     e(4, scene.hash),
                     e(5, scene.kd),
                     e(6, records),
-                    e(7, counter),
+                    e(7, scratch),
                 ],
             })
         })

@@ -23,6 +23,12 @@ pub enum WideMethod {
     /// box tests and answer. Beyond Guthe's paper; for coherent rays (camera rays, shadow rays to
     /// one light).
     Bvh8Packet,
+    /// [`WideMethod::Bvh8`]'s tree walked by streams of thousands of consecutive rays
+    /// ([`crate::wide::ray_stream`]): a node fetched once for every ray of the stream that reaches
+    /// it, each ray's own box tests, answer and events, no hand-over to single rays. Beyond both
+    /// papers (Barringer & Akenine-Möller 2014's dynamic ray streams); for incoherent closest-hit
+    /// rays inside a scene (diffuse bounces): any-hit rays gain nothing from it.
+    Bvh8Stream,
     /// [`WideMethod::Bvh4`]'s tree and visiting order without a stack ([`crate::wide::trail`]):
     /// Binder & Keller's node keys, bit trail and perfect hash at two key bits per level, a
     /// backtrack being one hash lookup and the parent's box tests again. Beyond both papers.
@@ -43,12 +49,13 @@ pub enum Collapse {
 
 impl WideMethod {
     /// Every wide method.
-    pub const ALL: [WideMethod; 6] = [
+    pub const ALL: [WideMethod; 7] = [
         WideMethod::Bvh4,
         WideMethod::Bvh8,
         WideMethod::Bvh4Naive,
         WideMethod::Bvh8Sah,
         WideMethod::Bvh8Packet,
+        WideMethod::Bvh8Stream,
         WideMethod::Bvh4Hash,
     ];
 
@@ -60,6 +67,7 @@ impl WideMethod {
             WideMethod::Bvh4Naive => "bvh4-naive",
             WideMethod::Bvh8Sah => "bvh8-sah",
             WideMethod::Bvh8Packet => "bvh8-packet",
+            WideMethod::Bvh8Stream => "bvh8-stream",
             WideMethod::Bvh4Hash => "bvh4-hash",
         }
     }
@@ -68,14 +76,18 @@ impl WideMethod {
     pub fn width(self) -> usize {
         match self {
             WideMethod::Bvh4 | WideMethod::Bvh4Naive | WideMethod::Bvh4Hash => 4,
-            WideMethod::Bvh8 | WideMethod::Bvh8Sah | WideMethod::Bvh8Packet => 8,
+            WideMethod::Bvh8 | WideMethod::Bvh8Sah | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream => 8,
         }
     }
 
     /// How the method's tree is collapsed.
     pub fn collapse(self) -> Collapse {
         match self {
-            WideMethod::Bvh4 | WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh4Hash => Collapse::PullUp,
+            WideMethod::Bvh4
+            | WideMethod::Bvh8
+            | WideMethod::Bvh8Packet
+            | WideMethod::Bvh8Stream
+            | WideMethod::Bvh4Hash => Collapse::PullUp,
             WideMethod::Bvh8Sah => Collapse::Optimal,
             WideMethod::Bvh4Naive => Collapse::EverySecondLevel,
         }
@@ -84,6 +96,17 @@ impl WideMethod {
     /// Whether rays are traced in packets ([`crate::wide::packet`]) rather than one at a time.
     pub fn packets(self) -> bool {
         self == WideMethod::Bvh8Packet
+    }
+
+    /// Whether rays are traced in streams ([`crate::wide::ray_stream`]) rather than one at a time.
+    pub fn streams(self) -> bool {
+        self == WideMethod::Bvh8Stream
+    }
+
+    /// Whether several rays share one walk of the tree (packets or streams): such a method's
+    /// events for one ray depend on the rays it is traced with.
+    pub fn shares_walks(self) -> bool {
+        self.packets() || self.streams()
     }
 
     /// Whether the method walks the tree without a stack, by node keys and a perfect hash
@@ -96,7 +119,10 @@ impl WideMethod {
     /// distance, stack pointer, and `width - 1` entries of (node, entry distance) per level. A
     /// packet's node, mask and stack (entries of node, ray mask and key) are shared by its
     /// [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET) rays; each ray adds its box interval, and
-    /// the single-ray state it needs when the packet hands it a subtree. The keyed method keeps
+    /// the single-ray state it needs when the packet hands it a subtree. A stream's stack holds
+    /// at most `width - 1` entries per level (node and list bounds), and each ray is in at most
+    /// that many lists (its index and entry distance), with its slab constants, interval and
+    /// answer besides (the stream shares nothing else). The keyed method keeps
     /// the node address, its key, its trail and a register (a parent node), whatever the depth.
     pub fn state_bytes(self, depth: u32) -> usize {
         if self.keyed() {
@@ -105,6 +131,11 @@ impl WideMethod {
                 _ => 8,
             };
             4 + 2 * key + 4
+        } else if self.streams() {
+            let entries = (self.width() - 1) * depth as usize;
+            let shared = 8 + 16 * entries;
+            let own = core::mem::size_of::<crate::intersect::SlabRay>() + 8 + 16;
+            8 * entries + own + shared.div_ceil(crate::wide::STREAM_RAYS)
         } else if self.packets() {
             let rays = crate::wide::packet::WIDE_PACKET;
             let shared = 8 + 8 + 4 + 16 * (self.width() - 1) * depth as usize;

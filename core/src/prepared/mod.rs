@@ -97,7 +97,8 @@ pub struct PreparedScene {
     /// none: a tree deeper than 64-bit keys allow ([`Error::TreeTooDeep`], which only that
     /// method then returns).
     pub wide4_hash: Option<Result<KeyedHash, Error>>,
-    /// The 8-wide tree by the pull-up ([`WideMethod::Bvh8`], [`WideMethod::Bvh8Packet`]).
+    /// The 8-wide tree by the pull-up ([`WideMethod::Bvh8`], [`WideMethod::Bvh8Packet`],
+    /// [`WideMethod::Bvh8Stream`]).
     pub wide8: Option<WideBvh<8>>,
     /// The 4-wide tree with every second level removed ([`WideMethod::Bvh4Naive`]).
     pub wide4_naive: Option<WideBvh<4>>,
@@ -175,7 +176,7 @@ impl PreparedScene {
             (wants(WideMethod::Bvh4) || wants(WideMethod::Bvh4Hash))
                 .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4.collapse()))
                 .transpose()?,
-            (wants(WideMethod::Bvh8) || wants(WideMethod::Bvh8Packet))
+            (wants(WideMethod::Bvh8) || wants(WideMethod::Bvh8Packet) || wants(WideMethod::Bvh8Stream))
                 .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse()))
                 .transpose()?,
             wants(WideMethod::Bvh4Naive)
@@ -302,7 +303,9 @@ impl PreparedScene {
         Ok(match method {
             WideMethod::Bvh4 | WideMethod::Bvh4Hash => WideTree::Four(self.wide4.as_ref().ok_or_else(missing)?),
             WideMethod::Bvh4Naive => WideTree::Four(self.wide4_naive.as_ref().ok_or_else(missing)?),
-            WideMethod::Bvh8 | WideMethod::Bvh8Packet => WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?),
+            WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream => {
+                WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?)
+            }
             WideMethod::Bvh8Sah => WideTree::Eight(self.wide8_sah.as_ref().ok_or_else(missing)?),
         })
     }

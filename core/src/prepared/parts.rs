@@ -77,7 +77,7 @@ impl Part {
             Method::Kd(_) => &[Part::Kd],
             Method::Wide(WideMethod::Bvh4) => &[Part::Wide4],
             Method::Wide(WideMethod::Bvh4Hash) => &[Part::Wide4, Part::Wide4Hash],
-            Method::Wide(WideMethod::Bvh8 | WideMethod::Bvh8Packet) => &[Part::Wide8],
+            Method::Wide(WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream) => &[Part::Wide8],
             Method::Wide(WideMethod::Bvh4Naive) => &[Part::Wide4Naive],
             Method::Wide(WideMethod::Bvh8Sah) => &[Part::Wide8Sah],
             Method::Stream(StreamMethod::Frustum8) => &[Part::Levels],

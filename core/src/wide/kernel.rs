@@ -29,6 +29,38 @@ pub trait ChildKernel {
     /// Writes the hit slots to `order` nearest first (ties to the smaller slot) and returns how
     /// many there are.
     fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize;
+
+    /// [`ChildKernel::test`] for the rays of a stream ([`crate::wide::ray_stream`]) at one
+    /// node: for the `k`-th ray `r` of `live`, its slab constants `slab[r]` tested over
+    /// `interval[r]`, its hit mask written to `masks[k]` and its entry distances to `t_enter[k]`
+    /// (`+inf` for a child it misses); per child, the least entry distance over the rays in list
+    /// order (a tie keeps the first) in `keys` and the rays that hit it counted in `counts`. A
+    /// vector kernel keeps the node's planes and the keys in registers over the whole list.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn stream_node<const W: usize>(
+        node: &WideNode<W>,
+        live: &[u32],
+        slab: &[SlabRay],
+        interval: &[(f32, f32)],
+        masks: &mut [u32],
+        t_enter: &mut [[f32; W]],
+        keys: &mut [f32; W],
+        counts: &mut [u32; W],
+    ) {
+        for ((&r, mask), t_out) in live.iter().zip(masks.iter_mut()).zip(t_enter.iter_mut()) {
+            let (lo, hi) = interval[r as usize];
+            let h = Self::test::<W>(node, &slab[r as usize], lo, hi);
+            for c in 0..W {
+                let hit = (h.mask >> c) & 1 != 0;
+                let t = if hit { h.t_enter[c] } else { f32::INFINITY };
+                t_out[c] = t;
+                keys[c] = if t < keys[c] { t } else { keys[c] };
+                counts[c] += u32::from(hit);
+            }
+            *mask = h.mask;
+        }
+    }
 }
 
 /// The reference: one child at a time through [`SlabRay::hit_scalar`], an insertion sort. The

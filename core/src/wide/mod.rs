@@ -13,7 +13,9 @@
 //! - [`trail`]: the same order without a stack, by node keys, a bit trail and a perfect hash over
 //!   the keys ([`keyed`]);
 //! - [`packet`]: the same tree walked by packets of rays of one octant (one order and one stack
-//!   per packet, each ray's own box tests, answers and events).
+//!   per packet, each ray's own box tests, answers and events);
+//! - [`ray_stream`]: the same tree walked by streams of thousands of rays (one order and one
+//!   stack per stream, each ray's own box tests, answers and events, no hand-over).
 
 mod kernel;
 pub mod keyed;
@@ -25,6 +27,8 @@ mod node;
 mod optimal;
 pub mod packet;
 mod prefetch;
+#[cfg(feature = "alloc")]
+pub mod ray_stream;
 pub mod trail;
 pub mod traverse;
 #[cfg(feature = "alloc")]
@@ -37,3 +41,9 @@ pub use node::{WideChild, WideNode, EMPTY_CHILD};
 pub use prefetch::{worth_prefetching, PrefetchingMemory, PREFETCH_ABOVE_BYTES};
 #[cfg(feature = "alloc")]
 pub use tree::{WideBvh, WideStats, WideTree};
+
+/// Rays per stream of [`ray_stream`] (consecutive rays of a batch, from its start): part of the
+/// rule, since a ray's events depend on the stream it is traced in. Streams of 2048-4096 rays
+/// measured best; at 16,384 the rays' records and lists outgrow a 1 MB L2 and the stream lost
+/// (BENCHMARKS.md, "A ray-stream prototype").
+pub const STREAM_RAYS: usize = 4096;

@@ -71,3 +71,21 @@ pub fn wide_soup(
     let w8 = WideBvh::<8>::build(&bvh, &tris, eight).unwrap();
     (scale, w4, w8)
 }
+
+/// Rays from all around a soup in the box 0..12 in every direction (incoherent), every seventh
+/// axis-parallel, every third ending at 5; with `zero_every`, every such ray from the first has no direction (untraceable).
+pub fn scattered_rays(n: usize, seed: u64, zero_every: Option<usize>) -> Vec<raytrail_core::Ray> {
+    let mut r = Rng(seed);
+    (0..n)
+        .map(|i| {
+            let mut d = r.v() - 0.5;
+            if i % 7 == 0 {
+                d = Vec3::new(0.0, d.y, 0.0);
+            }
+            if zero_every.is_some_and(|k| i % k == 0) {
+                d = Vec3::ZERO;
+            }
+            raytrail_core::Ray::new(r.v() * 14.0 - 2.0, d, 0.0, if i % 3 == 0 { 5.0 } else { f32::INFINITY })
+        })
+        .collect()
+}

@@ -174,7 +174,7 @@ pub fn structures(p: &PreparedScene) -> String {
         );
     }
     // The packet method walks bvh8's tree, the keyed one bvh4's.
-    for m in WideMethod::ALL.into_iter().filter(|m| !m.packets() && !m.keyed()) {
+    for m in WideMethod::ALL.into_iter().filter(|m| !m.shares_walks() && !m.keyed()) {
         if let Ok(t) = p.wide_tree(m) {
             let st = t.stats();
             let w = m.width();

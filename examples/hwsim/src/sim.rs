@@ -229,8 +229,8 @@ pub struct MethodRun {
 
 /// Simulates `method` over `rays` in lockstep warps, with the watertight triangle test: any BVH2
 /// method (with the key width the tree needs), the kd methods but the packet one, and every wide
-/// method but the packet one and the keyed one. kd-packet and bvh8-packet are lockstep units of
-/// their own (rays sharing a node) and bvh4-hash runs as one loop per ray, not a step function;
+/// method but the packet, stream and keyed ones. kd-packet, bvh8-packet and bvh8-stream are
+/// lockstep units of their own (rays sharing a node) and bvh4-hash runs as one loop per ray, not a step function;
 /// they are an [`Error::Unsupported`], as is a method `prepared` lacks the tables of
 /// ([`Error::NotPrepared`]).
 pub fn simulate(
@@ -243,7 +243,7 @@ pub fn simulate(
     let mut run = match method {
         Method::Bvh2(m) => simulate_bvh2(prepared, m, rays, cfg)?,
         Method::Kd(m) => simulate_kd(prepared, m, rays, cfg)?,
-        Method::Wide(m) if !m.packets() && !m.keyed() => simulate_wide(prepared, m, rays, cfg)?,
+        Method::Wide(m) if !m.shares_walks() && !m.keyed() => simulate_wide(prepared, m, rays, cfg)?,
         _ => return Err(Error::Unsupported { method: method.name(), by: "the lockstep simulator" }),
     };
     run.report.method = method;

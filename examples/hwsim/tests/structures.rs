@@ -87,7 +87,7 @@ fn check_all(s: &Scenario, rays: &[Ray], query: Query, warp: usize) {
             _ => assert_eq!((r.stack_pushes, r.transitions.stack_pop, r.stack_bytes_per_ray()), (0, 0, None), "{m}"),
         }
     }
-    for m in WideMethod::ALL.into_iter().filter(|m| !m.packets() && !m.keyed()).map(Method::Wide) {
+    for m in WideMethod::ALL.into_iter().filter(|m| !m.shares_walks() && !m.keyed()).map(Method::Wide) {
         let r = check(s, m, rays, query, warp, &stack).report;
         if query == Query::Closest {
             // A closest-hit wide traversal ends with an empty stack: every entry is popped

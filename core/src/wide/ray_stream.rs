@@ -1,0 +1,304 @@
+//! Rays through a wide BVH as one stream per chunk (dynamic ray-stream traversal, Barringer and
+//! Akenine-Möller 2014): a node is fetched once for all the rays of the stream that reach it, each
+//! of them tests its children with its own single-ray box test, and the rays that hit a child go
+//! on in that child's list. On interiors a node near the root is reached by thousands of a
+//! chunk's rays, so the load a single diffuse ray waits for at each visit is paid once, and the
+//! rays' box tests are independent work rather than one chain of latencies.
+//!
+//! The rule (what the reference, every fast path and every backend must follow):
+//! - Rays are traced in streams of [`STREAM_RAYS`] consecutive rays of the batch, from its start.
+//! - A stream visits a child with the list of its rays whose own box test (the single-ray test,
+//!   over the ray's own interval at that moment) hits the child; every ray of the list records
+//!   the visit. Lists are in the order of the rays in the batch.
+//! - A node's hit children are ordered by their key, the least entry distance over the rays that
+//!   hit them, nearest first with ties to the smaller slot, for closest-hit queries; in slot order
+//!   for any-hit ones (Guthe's unsorted occlusion). The first is visited next with all its rays;
+//!   the others are pushed with their lists, each ray with its own entry distance (onto a full
+//!   stack of [`WIDE_STACK`] entries, none is: the single-ray traversal's bound).
+//! - At a leaf, every ray of the list, in list order, tests its triangles as the single-ray method
+//!   does; an any-hit ray that finds one leaves the stream.
+//! - A popped entry: every ray of its list still in the stream records a stack pop, and those
+//!   whose own entry distance is still within their interval (the single-ray pop's test) visit
+//!   the child. An entry that no ray reaches is dropped.
+//! - Unlike a packet, a stream hands no subtree to single rays: thin lists stay in the stream
+//!   (handing them over reloaded what the stream had in cache: BENCHMARKS.md, "A ray-stream
+//!   prototype").
+//!
+//! Closest hits are the single-ray method's bit for bit (every ray still tests every leaf whose
+//! box it enters before its closest hit, and ties go to the smaller primitive id whatever the
+//! order); any-hit answers agree on occlusion. A ray's events depend on the other rays of its
+//! stream only through the order of the visits, never through the order within a list.
+
+use super::kernel::{ChildHits, ChildKernel};
+use super::memory::WideMemory;
+use super::node::WideChild;
+use super::traverse::{leaf, visiting_order, WideRayContext, WideRoot, WIDE_STACK};
+use crate::intersect::{NoPair, SlabRay, TriangleTest};
+use crate::method::Query;
+use crate::observe::{Backtrack, Observer};
+use crate::traverse::{begin, QueryState};
+use crate::{Hit, Ray};
+use alloc::vec::Vec;
+
+pub use super::STREAM_RAYS;
+
+/// A postponed child and where its list lies in the buffer of lists.
+#[derive(Clone, Copy)]
+struct Entry {
+    child: WideChild,
+    start: usize,
+    len: usize,
+}
+
+/// A list entry: a ray (by its place in the stream) and its entry distance, as one word so the
+/// lists are written with one store per entry.
+#[inline(always)]
+fn item(ray: u32, t: f32) -> u64 {
+    u64::from(ray) | (u64::from(t.to_bits()) << 32)
+}
+
+/// The ray and the entry distance of a list entry.
+#[inline(always)]
+fn unpack(item: u64) -> (usize, f32) {
+    ((item as u32) as usize, f32::from_bits((item >> 32) as u32))
+}
+
+/// The working memory of a stream, kept from one stream to the next.
+struct StreamScratch<const W: usize, T: TriangleTest, O> {
+    /// Each traced ray's context, answer and observer, and its place in the chunk.
+    ctx: Vec<WideRayContext<T>>,
+    q: Vec<QueryState>,
+    obs: Vec<O>,
+    place: Vec<u32>,
+    /// Each ray's slab constants and box interval: what a node's box tests read.
+    slab: Vec<SlabRay>,
+    interval: Vec<(f32, f32)>,
+    /// Whether each ray is still in the stream (an answered any-hit ray is not).
+    active: Vec<bool>,
+    /// The lists of the postponed children, the nearest on top.
+    items: Vec<u64>,
+    stack: Vec<Entry>,
+    /// The rays visiting the current child.
+    live: Vec<u32>,
+    /// Per ray of `live`: its hit mask and entry distances at the current node.
+    masks: Vec<u32>,
+    t_enter: Vec<[f32; W]>,
+}
+
+impl<const W: usize, T: TriangleTest, O> StreamScratch<W, T, O> {
+    /// Empty buffers.
+    fn new() -> Self {
+        Self {
+            ctx: Vec::new(),
+            q: Vec::new(),
+            obs: Vec::new(),
+            place: Vec::new(),
+            slab: Vec::new(),
+            interval: Vec::new(),
+            active: Vec::new(),
+            items: Vec::new(),
+            stack: Vec::new(),
+            live: Vec::new(),
+            masks: Vec::new(),
+            t_enter: Vec::new(),
+        }
+    }
+}
+
+/// Traces `rays` into `hits` (pairs up to the shorter of the two) in streams of [`STREAM_RAYS`],
+/// the children tested and ordered by `K`, the leaves tested with `K`'s leaf test, per the rule in
+/// the module docs; hands each ray's index and observer to `done` once its stream is traced.
+/// Inlined, so that a backend's caller compiled for a vector extension compiles all of it so.
+#[inline(always)]
+pub fn trace_wide_streams<
+    const W: usize,
+    M: WideMemory<W> + ?Sized,
+    T: TriangleTest,
+    K: ChildKernel,
+    O: Observer + Default,
+>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    query: Query,
+    mut done: impl FnMut(usize, O),
+) {
+    let n = rays.len().min(hits.len());
+    let mut s = StreamScratch::<W, T, O>::new();
+    for (c, chunk) in rays[..n].chunks(STREAM_RAYS).enumerate() {
+        let base = c * STREAM_RAYS;
+        trace_wide_stream::<W, M, T, K, O>(mem, root, chunk, query, &mut s);
+        // A ray that `begin` turned away is a miss with no events.
+        hits[base..base + chunk.len()].fill(Hit::MISS);
+        let mut traced = 0;
+        for i in 0..chunk.len() {
+            if s.place.get(traced).is_some_and(|&p| p as usize == i) {
+                hits[base + i] = s.q[traced].hit;
+                done(base + i, core::mem::take(&mut s.obs[traced]));
+                traced += 1;
+            } else {
+                done(base + i, O::default());
+            }
+        }
+    }
+}
+
+/// Traces one stream of `rays` per the module docs; each traced ray's place in `rays` (in
+/// increasing order), answer and observer are left in `s`.
+#[inline(always)]
+fn trace_wide_stream<
+    const W: usize,
+    M: WideMemory<W> + ?Sized,
+    T: TriangleTest,
+    K: ChildKernel,
+    O: Observer + Default,
+>(
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    query: Query,
+    s: &mut StreamScratch<W, T, O>,
+) {
+    s.ctx.clear();
+    s.q.clear();
+    s.obs.clear();
+    s.place.clear();
+    s.slab.clear();
+    s.interval.clear();
+    s.active.clear();
+    s.items.clear();
+    s.stack.clear();
+    s.live.clear();
+    for (i, ray) in rays.iter().enumerate() {
+        let Some((c, q)) = begin::<T, NoPair>(ray, root.scene_scale, query) else { continue };
+        s.live.push(s.ctx.len() as u32);
+        s.slab.push(c.slab);
+        s.interval.push(c.box_interval(q.limit()));
+        s.ctx.push(c);
+        s.q.push(q);
+        s.obs.push(O::default());
+        s.place.push(i as u32);
+        s.active.push(true);
+    }
+    let mut current = (!s.live.is_empty()).then_some(root.root);
+    let mut budget = root.max_steps;
+    while let Some(child) = current {
+        if O::ENABLED {
+            for &r in &s.live {
+                s.obs[r as usize].node(child.node_ref());
+            }
+        }
+        let next = match child {
+            WideChild::Node(index) => expand::<W, M, T, K, O>(mem, index, query, s),
+            WideChild::Leaf { first, count } => {
+                for &r in &s.live {
+                    let r = r as usize;
+                    let (c, q) = (&s.ctx[r], &mut s.q[r]);
+                    leaf::<W, M, T, K, O>(mem, first, count, c, q, &mut s.obs[r]);
+                    if q.is_answered() {
+                        s.active[r] = false;
+                        s.interval[r].1 = f32::NEG_INFINITY;
+                    } else {
+                        s.interval[r].1 = c.box_interval(q.limit()).1;
+                    }
+                }
+                None
+            }
+        };
+        current = match next.or_else(|| pop(s)) {
+            Some(c) if budget > 0 => {
+                budget -= 1;
+                Some(c)
+            }
+            _ => None,
+        };
+    }
+}
+
+/// Tests node `index`'s children for the rays of `s.live`, pushes the hit children but the first
+/// with their lists, and leaves the first child's rays in `s.live`; `None` when no child is hit.
+#[inline(always)]
+fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
+    mem: &M,
+    index: u32,
+    query: Query,
+    s: &mut StreamScratch<W, T, O>,
+) -> Option<WideChild> {
+    let node = mem.wide_node(index);
+    let n = s.live.len();
+    s.masks.resize(n, 0);
+    s.t_enter.resize(n, [f32::INFINITY; W]);
+    let (mut counts, mut keys) = ([0u32; W], [f32::INFINITY; W]);
+    K::stream_node::<W>(&node, &s.live, &s.slab, &s.interval, &mut s.masks, &mut s.t_enter, &mut keys, &mut counts);
+    let hit_slots = (0..W).fold(0u32, |m, c| m | u32::from(counts[c] > 0) << c);
+    if hit_slots == 0 {
+        return None;
+    }
+    let mut order = [0u32; W];
+    let count = visiting_order::<W, K>(&ChildHits { t_enter: keys, mask: hit_slots }, query.is_any(), &mut order);
+    // A list per hit child, in visiting order from the farthest, so that the first child's lies
+    // on top and the nearest pushed one's under it; each padded by one entry, so that every ray
+    // writes to the list and moves on only where it hit (a write without a branch).
+    let spare = s.items.len();
+    let mut at = [spare; W];
+    let mut start = [spare; W];
+    let mut end = spare + 1;
+    for k in (0..count).rev() {
+        let slot = order[k] as usize % W;
+        (at[slot], start[slot]) = (end, end);
+        end += counts[slot] as usize + 1;
+        if k > 0 && s.stack.len() < WIDE_STACK {
+            if let Some(c) = node.child_ref(slot) {
+                s.stack.push(Entry { child: c, start: end - counts[slot] as usize - 1, len: counts[slot] as usize });
+            }
+        }
+    }
+    s.items.resize(end, 0);
+    // One pass over the rays per hit child: the write position stays in a register.
+    for &slot in &order[..count] {
+        let c = slot as usize % W;
+        let mut to = at[c];
+        for ((&r, &m), t_enter) in s.live.iter().zip(&s.masks).zip(&s.t_enter) {
+            // SAFETY: `to` stays within `items`: the child's list has one entry to spare beyond
+            // its count of rays, and only a ray that hit it moves `to` on.
+            unsafe { *s.items.get_unchecked_mut(to) = item(r, t_enter[c]) };
+            to += ((m >> c) & 1) as usize;
+        }
+        at[c] = to;
+    }
+    // The first child's rays visit it with no test of their entry distance (a ray goes straight
+    // on to its nearest child, as it would alone), and its list leaves the buffer.
+    let first = order[0] as usize % W;
+    s.live.clear();
+    s.live.extend(s.items[start[first]..at[first]].iter().map(|&it| unpack(it).0 as u32));
+    s.items.truncate(start[first] - 1);
+    node.child_ref(first)
+}
+
+/// The next postponed child that some ray still reaches, with those rays in `s.live` (see the
+/// module docs), or `None` when the stack runs out.
+#[inline(always)]
+fn pop<const W: usize, T: TriangleTest, O: Observer>(s: &mut StreamScratch<W, T, O>) -> Option<WideChild> {
+    while let Some(e) = s.stack.pop() {
+        // Every ray of the list writes, and those that reach the child move on (no branch on a
+        // test that differs from ray to ray).
+        s.live.resize(e.len + 1, 0);
+        let mut n = 0;
+        for &it in &s.items[e.start..e.start + e.len] {
+            let (r, t) = unpack(it);
+            if O::ENABLED && s.active[r] {
+                s.obs[r].backtrack(0, Backtrack::StackPop);
+            }
+            s.live[n] = r as u32;
+            // An answered any-hit ray's interval ends at -inf: no entry reaches it.
+            n += usize::from(t <= s.interval[r].1);
+        }
+        s.live.truncate(n);
+        s.items.truncate(e.start - 1);
+        if !s.live.is_empty() {
+            return Some(e.child);
+        }
+    }
+    None
+}
