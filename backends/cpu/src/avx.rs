@@ -15,7 +15,7 @@ use raytrail_core::wide::keyed::WideKeyedMemory;
 use raytrail_core::wide::ray_stream::trace_wide_streams;
 use raytrail_core::wide::trail::trace_wide_trail_batch;
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
-use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, WideMemory, WideNode};
+use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, StreamRay, WideMemory, WideNode};
 use raytrail_core::{Hit, Ray};
 use std::arch::x86_64::{
     _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_ps, _mm256_castps_si256,
@@ -58,8 +58,7 @@ impl ChildKernel for AvxKernel {
     fn stream_node<const W: usize>(
         node: &WideNode<W>,
         live: &[u32],
-        slab: &[SlabRay],
-        interval: &[(f32, f32)],
+        rays: &[StreamRay],
         masks: &mut [u32],
         t_enter: &mut [[f32; W]],
         keys: &mut [f32; W],
@@ -67,9 +66,9 @@ impl ChildKernel for AvxKernel {
     ) {
         if W == 8 {
             // SAFETY: only `trace_batch` and `trace_streams` use this kernel, where AVX2 runs.
-            unsafe { stream_node_avx(node, live, slab, interval, masks, t_enter, keys, counts) }
+            unsafe { stream_node_avx(node, live, rays, masks, t_enter, keys, counts) }
         } else {
-            FastKernel::stream_node(node, live, slab, interval, masks, t_enter, keys, counts)
+            FastKernel::stream_node(node, live, rays, masks, t_enter, keys, counts)
         }
     }
 
@@ -131,15 +130,14 @@ unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, t
 ///
 /// # Safety
 /// The processor must run the AVX2 path ([`available`]); `W` must be 8; `masks` and `t_enter`
-/// must hold an entry per ray of `live`, and every ray of `live` must index `slab` and `interval`.
+/// must hold an entry per ray of `live`, and every ray of `live` must index `rays`.
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 #[allow(clippy::too_many_arguments)]
 unsafe fn stream_node_avx<const W: usize>(
     node: &WideNode<W>,
     live: &[u32],
-    slab: &[SlabRay],
-    interval: &[(f32, f32)],
+    rays: &[StreamRay],
     masks: &mut [u32],
     t_enter: &mut [[f32; W]],
     keys: &mut [f32; W],
@@ -151,8 +149,8 @@ unsafe fn stream_node_avx<const W: usize>(
     let splat = _mm256_set1_ps;
     let (mut key, mut count) = (ld(keys), _mm256_loadu_si256(counts.as_ptr().cast()));
     for (k, &r) in live.iter().enumerate() {
-        let s = slab.get_unchecked(r as usize);
-        let (lo, hi) = *interval.get_unchecked(r as usize);
+        let ray = rays.get_unchecked(r as usize);
+        let (s, (lo, hi)) = (&ray.slab, ray.interval);
         let (o, inv) = (s.origin.to_array(), s.inv_dir.to_array());
         let (mut te, mut tx) = (splat(lo), splat(hi));
         for (a, &(l, h)) in planes.iter().enumerate() {

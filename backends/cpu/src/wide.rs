@@ -1,10 +1,9 @@
 //! The wide-BVH methods' loop for one chunk, monomorphized per width x memory x triangle test x
 //! recording, with the fast child kernel (SIMD box tests, the sorting network), in the AVX2 loop
 //! where the processor has AVX2; the packet method's loop over the chunk's packets and the stream
-//! method's over its streams likewise. The
-//! memory prefetches hit children where that pays (a large tree, incoherent rays, any-hit ones only
-//! in packets: [`worth_prefetching`]; in the packet loop, only the subtrees handed over to single
-//! rays prefetch).
+//! method's over its streams likewise. The memory prefetches hit children where that pays (a large
+//! tree, incoherent rays, any-hit ones only in packets: [`worth_prefetching`]; in the packet loop,
+//! only the subtrees handed over to single rays prefetch).
 
 use crate::chunk::Chunk;
 use core::marker::PhantomData;

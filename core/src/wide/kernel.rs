@@ -31,8 +31,8 @@ pub trait ChildKernel {
     fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize;
 
     /// [`ChildKernel::test`] for the rays of a stream ([`crate::wide::ray_stream`]) at one
-    /// node: for the `k`-th ray `r` of `live`, its slab constants `slab[r]` tested over
-    /// `interval[r]`, its hit mask written to `masks[k]` and its entry distances to `t_enter[k]`
+    /// node: for the `k`-th ray `r` of `live`, its slab constants `rays[r].slab` tested over
+    /// `rays[r].interval`, its hit mask written to `masks[k]` and its entry distances to `t_enter[k]`
     /// (`+inf` for a child it misses); per child, the least entry distance over the rays in list
     /// order (a tie keeps the first) in `keys` and the rays that hit it counted in `counts`. A
     /// vector kernel keeps the node's planes and the keys in registers over the whole list.
@@ -41,16 +41,16 @@ pub trait ChildKernel {
     fn stream_node<const W: usize>(
         node: &WideNode<W>,
         live: &[u32],
-        slab: &[SlabRay],
-        interval: &[(f32, f32)],
+        rays: &[StreamRay],
         masks: &mut [u32],
         t_enter: &mut [[f32; W]],
         keys: &mut [f32; W],
         counts: &mut [u32; W],
     ) {
         for ((&r, mask), t_out) in live.iter().zip(masks.iter_mut()).zip(t_enter.iter_mut()) {
-            let (lo, hi) = interval[r as usize];
-            let h = Self::test::<W>(node, &slab[r as usize], lo, hi);
+            let ray = &rays[r as usize];
+            let (lo, hi) = ray.interval;
+            let h = Self::test::<W>(node, &ray.slab, lo, hi);
             for c in 0..W {
                 let hit = (h.mask >> c) & 1 != 0;
                 let t = if hit { h.t_enter[c] } else { f32::INFINITY };
@@ -61,6 +61,20 @@ pub trait ChildKernel {
             *mask = h.mask;
         }
     }
+}
+
+/// What a stream's box tests read of one ray ([`ChildKernel::stream_node`]), with its interval
+/// start for its leaves: one cache line, where the slab constants and the interval in two arrays
+/// took two.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct StreamRay {
+    /// Slab-test constants.
+    pub slab: SlabRay,
+    /// The box interval: `RayContext::box_interval` of the closest hit so far.
+    pub interval: (f32, f32),
+    /// The ray's own interval start (its leaves' triangle tests).
+    pub tmin: f32,
 }
 
 /// The reference: one child at a time through [`SlabRay::hit_scalar`], an insertion sort. The

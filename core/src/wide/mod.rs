@@ -34,7 +34,7 @@ pub mod traverse;
 #[cfg(feature = "alloc")]
 mod tree;
 
-pub use kernel::{sort_keys, ChildHits, ChildKernel, FastKernel, ReferenceKernel};
+pub use kernel::{sort_keys, ChildHits, ChildKernel, FastKernel, ReferenceKernel, StreamRay};
 pub use leaf_block::LeafBlock;
 pub use memory::{WideMemory, WideSliceMemory};
 pub use node::{WideChild, WideNode, EMPTY_CHILD};

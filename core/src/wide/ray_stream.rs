@@ -29,11 +29,11 @@
 //! order); any-hit answers agree on occlusion. A ray's events depend on the other rays of its
 //! stream only through the order of the visits, never through the order within a list.
 
-use super::kernel::{ChildHits, ChildKernel};
+use super::kernel::{ChildHits, ChildKernel, StreamRay};
 use super::memory::WideMemory;
 use super::node::WideChild;
-use super::traverse::{leaf, visiting_order, WideRayContext, WideRoot, WIDE_STACK};
-use crate::intersect::{NoPair, SlabRay, TriangleTest};
+use super::traverse::{leaf_with, visiting_order, WideRoot, WIDE_STACK};
+use crate::intersect::{NoPair, TriangleTest};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
 use crate::traverse::{begin, QueryState};
@@ -65,14 +65,16 @@ fn unpack(item: u64) -> (usize, f32) {
 
 /// The working memory of a stream, kept from one stream to the next.
 struct StreamScratch<const W: usize, T: TriangleTest, O> {
-    /// Each traced ray's context, answer and observer, and its place in the chunk.
-    ctx: Vec<WideRayContext<T>>,
+    /// Each traced ray's box constants and interval (what a node's box tests read), triangle
+    /// constants, answer and observer, and its place in the chunk. Kept apart rather than as whole
+    /// contexts: a ray's leaves read its triangle constants, made once, rather than the lazily
+    /// made copy inside a context that also holds the ray and its slab constants (1.08-1.10x on
+    /// the interiors' diffuse rays: BENCHMARKS.md, "`bvh8-stream` on every backend").
+    rays: Vec<StreamRay>,
+    tri: Vec<T::PerRay>,
     q: Vec<QueryState>,
     obs: Vec<O>,
     place: Vec<u32>,
-    /// Each ray's slab constants and box interval: what a node's box tests read.
-    slab: Vec<SlabRay>,
-    interval: Vec<(f32, f32)>,
     /// Whether each ray is still in the stream (an answered any-hit ray is not).
     active: Vec<bool>,
     /// The lists of the postponed children, the nearest on top.
@@ -89,12 +91,11 @@ impl<const W: usize, T: TriangleTest, O> StreamScratch<W, T, O> {
     /// Empty buffers.
     fn new() -> Self {
         Self {
-            ctx: Vec::new(),
+            rays: Vec::new(),
+            tri: Vec::new(),
             q: Vec::new(),
             obs: Vec::new(),
             place: Vec::new(),
-            slab: Vec::new(),
-            interval: Vec::new(),
             active: Vec::new(),
             items: Vec::new(),
             stack: Vec::new(),
@@ -160,22 +161,20 @@ fn trace_wide_stream<
     query: Query,
     s: &mut StreamScratch<W, T, O>,
 ) {
-    s.ctx.clear();
+    s.rays.clear();
+    s.tri.clear();
     s.q.clear();
     s.obs.clear();
     s.place.clear();
-    s.slab.clear();
-    s.interval.clear();
     s.active.clear();
     s.items.clear();
     s.stack.clear();
     s.live.clear();
     for (i, ray) in rays.iter().enumerate() {
         let Some((c, q)) = begin::<T, NoPair>(ray, root.scene_scale, query) else { continue };
-        s.live.push(s.ctx.len() as u32);
-        s.slab.push(c.slab);
-        s.interval.push(c.box_interval(q.limit()));
-        s.ctx.push(c);
+        s.live.push(s.rays.len() as u32);
+        s.rays.push(StreamRay { slab: c.slab, interval: c.box_interval(q.limit()), tmin: c.ray.tmin });
+        s.tri.push(c.tri());
         s.q.push(q);
         s.obs.push(O::default());
         s.place.push(i as u32);
@@ -194,13 +193,13 @@ fn trace_wide_stream<
             WideChild::Leaf { first, count } => {
                 for &r in &s.live {
                     let r = r as usize;
-                    let (c, q) = (&s.ctx[r], &mut s.q[r]);
-                    leaf::<W, M, T, K, O>(mem, first, count, c, q, &mut s.obs[r]);
+                    let (ray, q) = (&mut s.rays[r], &mut s.q[r]);
+                    leaf_with::<W, M, T, K, O>(mem, first, count, &s.tri[r], ray.tmin, q, &mut s.obs[r]);
                     if q.is_answered() {
                         s.active[r] = false;
-                        s.interval[r].1 = f32::NEG_INFINITY;
+                        ray.interval.1 = f32::NEG_INFINITY;
                     } else {
-                        s.interval[r].1 = c.box_interval(q.limit()).1;
+                        ray.interval.1 = ray.slab.widen(ray.tmin, q.limit()).1;
                     }
                 }
                 None
@@ -230,7 +229,7 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
     s.masks.resize(n, 0);
     s.t_enter.resize(n, [f32::INFINITY; W]);
     let (mut counts, mut keys) = ([0u32; W], [f32::INFINITY; W]);
-    K::stream_node::<W>(&node, &s.live, &s.slab, &s.interval, &mut s.masks, &mut s.t_enter, &mut keys, &mut counts);
+    K::stream_node::<W>(&node, &s.live, &s.rays, &mut s.masks, &mut s.t_enter, &mut keys, &mut counts);
     let hit_slots = (0..W).fold(0u32, |m, c| m | u32::from(counts[c] > 0) << c);
     if hit_slots == 0 {
         return None;
@@ -292,7 +291,7 @@ fn pop<const W: usize, T: TriangleTest, O: Observer>(s: &mut StreamScratch<W, T,
             }
             s.live[n] = r as u32;
             // An answered any-hit ray's interval ends at -inf: no entry reaches it.
-            n += usize::from(t <= s.interval[r].1);
+            n += usize::from(t <= s.rays[r].interval.1);
         }
         s.live.truncate(n);
         s.items.truncate(e.start - 1);

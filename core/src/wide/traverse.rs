@@ -270,19 +270,34 @@ pub(crate) fn leaf<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K
     q: &mut QueryState,
     obs: &mut O,
 ) -> bool {
-    let per_ray = ctx.tri();
+    leaf_with::<W, M, T, K, O>(mem, first, count, &ctx.tri(), ctx.ray.tmin, q, obs)
+}
+
+/// [`leaf`] with the ray's triangle constants and interval start given (a stream keeps them
+/// apart from the rest of a ray's context).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn leaf_with<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
+    mem: &M,
+    first: u32,
+    count: u32,
+    per_ray: &T::PerRay,
+    tmin: f32,
+    q: &mut QueryState,
+    obs: &mut O,
+) -> bool {
     let mut taken = false;
     let end = first + count;
     let mut pos = first;
     while pos < end {
         let (hits, n) = if K::BLOCKS {
             let block = mem.wide_block(pos / BLOCK as u32);
-            (T::intersect_block(&per_ray, &block, ctx.ray.tmin, q.limit()), (end - pos).min(BLOCK as u32))
+            (T::intersect_block(per_ray, &block, tmin, q.limit()), (end - pos).min(BLOCK as u32))
         } else {
             let tri = mem.wide_triangle(pos);
             let [a, b, c] = &*tri;
             let mut hits = BlockHits::NONE;
-            hits.set(0, T::intersect_in_place(&per_ray, [a.as_ref(), b.as_ref(), c.as_ref()], ctx.ray.tmin, q.limit()));
+            hits.set(0, T::intersect_in_place(per_ray, [a.as_ref(), b.as_ref(), c.as_ref()], tmin, q.limit()));
             (hits, 1)
         };
         let live = hits.mask & ((1 << n) - 1);
