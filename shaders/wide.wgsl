@@ -74,13 +74,18 @@ fn wide_slot(node: u32, i: u32) -> WideSlot {
 var<private> WT_T: array<f32, WIDE_W>;
 var<private> WT_SLOT: array<u32, WIDE_W>;
 
-// Child `i`'s box test, its sort keys written at index `i` (a constant at every call).
-fn wide_test_child(node: u32, i: u32, lo_t: f32, hi_t: f32) -> u32 {
+// Child `i`'s box test over `[lo_t, hi_t]` (`SlabRay::hit`).
+fn wide_child_hit(node: u32, i: u32, lo_t: f32, hi_t: f32) -> BoxHit {
     let lo = vec3<f32>(bitcast<f32>(wide_word(node, i)), bitcast<f32>(wide_word(node, WIDE_W + i)),
         bitcast<f32>(wide_word(node, 2u * WIDE_W + i)));
     let hi = vec3<f32>(bitcast<f32>(wide_word(node, 3u * WIDE_W + i)),
         bitcast<f32>(wide_word(node, 4u * WIDE_W + i)), bitcast<f32>(wide_word(node, 5u * WIDE_W + i)));
-    let h = slab_hit(lo, hi, lo_t, hi_t);
+    return slab_hit(lo, hi, lo_t, hi_t);
+}
+
+// Child `i`'s box test, its sort keys written at index `i` (a constant at every call).
+fn wide_test_child(node: u32, i: u32, lo_t: f32, hi_t: f32) -> u32 {
+    let h = wide_child_hit(node, i, lo_t, hi_t);
     // `sort_keys`: a missed child sorts after every hit one.
     WT_T[i] = select(bitcast<f32>(0x7f800000u), h.t_enter, h.hit);
     WT_SLOT[i] = select(i + WIDE_W, i, h.hit);

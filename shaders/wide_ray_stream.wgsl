@@ -187,7 +187,7 @@ fn ws_check(w: u32) {
         rec_backtrack(0u, VIA_STACK_POP);
         let iv = box_interval(q_limit());
         // The entry distance as the push saw it: `slab_hit` makes it from the interval's start.
-        let t = ws_entry_distance(e.node, e.slot % WIDE_W, iv.x);
+        let t = wide_child_hit(e.node, e.slot % WIDE_W, iv.x, iv.x).t_enter;
         if t <= iv.y {
             live = live | (1u << b);
         }
@@ -196,15 +196,6 @@ fn ws_check(w: u32) {
     if live != 0u {
         atomicOr(&WS_ANY, 1u);
     }
-}
-
-// Child `i` of `node`'s entry distance for the current ray from `lo_t` (hit or not).
-fn ws_entry_distance(node: u32, i: u32, lo_t: f32) -> f32 {
-    let lo = vec3<f32>(bitcast<f32>(wide_word(node, i)), bitcast<f32>(wide_word(node, WIDE_W + i)),
-        bitcast<f32>(wide_word(node, 2u * WIDE_W + i)));
-    let hi = vec3<f32>(bitcast<f32>(wide_word(node, 3u * WIDE_W + i)),
-        bitcast<f32>(wide_word(node, 4u * WIDE_W + i)), bitcast<f32>(wide_word(node, 5u * WIDE_W + i)));
-    return slab_hit(lo, hi, lo_t, lo_t).t_enter;
 }
 
 // Visits `c` next with the current set, within the step budget.

@@ -68,11 +68,9 @@ impl WideRun<'_> {
         chunk: Chunk<'_>,
     ) -> Result<Counters, Error> {
         let (root, query) = (self.root, self.opts.query);
-        if self.method.packets() {
-            return self.run_shared(chunk, &Packets::<W, M, T> { mem, root, query, test: PhantomData });
-        }
-        if self.method.streams() {
-            return self.run_shared(chunk, &Streams::<W, M, T> { mem, root, query, test: PhantomData });
+        if self.method.shares_walks() {
+            let streams = self.method.streams();
+            return self.run_shared(chunk, &SharedWalk::<W, M, T> { mem, root, query, streams, test: PhantomData });
         }
         let stack = StackBatch::<W, M, T> { mem, root, query, test: PhantomData };
         record_rays(self.scene, self.method, self.opts.record, chunk, &stack)
@@ -111,31 +109,22 @@ trait SharedWalks {
     fn trace<O: Observer + Default>(&self, rays: &[Ray], hits: &mut [Hit], done: &mut impl FnMut(usize, O));
 }
 
-/// The packet loop ([`packets`]).
-struct Packets<'m, const W: usize, M, T> {
+/// The packet loop ([`packets`]) or, with `streams`, the stream loop ([`streams`]).
+struct SharedWalk<'m, const W: usize, M, T> {
     mem: &'m M,
     root: WideRoot,
     query: Query,
+    streams: bool,
     test: PhantomData<T>,
 }
 
-impl<const W: usize, M: WideMemory<W>, T: TriangleTest> SharedWalks for Packets<'_, W, M, T> {
+impl<const W: usize, M: WideMemory<W>, T: TriangleTest> SharedWalks for SharedWalk<'_, W, M, T> {
     fn trace<O: Observer + Default>(&self, rays: &[Ray], hits: &mut [Hit], done: &mut impl FnMut(usize, O)) {
-        packets::<W, M, T, O>(self.mem, self.root, rays, hits, self.query, done);
-    }
-}
-
-/// The stream loop ([`streams`]).
-struct Streams<'m, const W: usize, M, T> {
-    mem: &'m M,
-    root: WideRoot,
-    query: Query,
-    test: PhantomData<T>,
-}
-
-impl<const W: usize, M: WideMemory<W>, T: TriangleTest> SharedWalks for Streams<'_, W, M, T> {
-    fn trace<O: Observer + Default>(&self, rays: &[Ray], hits: &mut [Hit], done: &mut impl FnMut(usize, O)) {
-        streams::<W, M, T, O>(self.mem, self.root, rays, hits, self.query, done);
+        if self.streams {
+            streams::<W, M, T, O>(self.mem, self.root, rays, hits, self.query, done);
+        } else {
+            packets::<W, M, T, O>(self.mem, self.root, rays, hits, self.query, done);
+        }
     }
 }
 
