@@ -36,6 +36,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+mod builder;
 pub mod prelude;
 
 pub use raytrail_conformance as conformance;
@@ -43,48 +44,11 @@ pub use raytrail_core as core;
 pub use raytrail_cpu as cpu;
 pub use raytrail_wgpu as gpu;
 
+pub use builder::Builder;
+
 use raytrail_conformance::NamedScene;
-use raytrail_core::bvh2::{Bvh2, SahBuilder};
 use raytrail_core::mesh::{LoadOptions, LoadReport};
-use raytrail_core::scene::Scene;
 use std::path::Path;
-
-/// Which builder makes the canonical tree.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Builder {
-    /// The core's binned SAH builder.
-    #[default]
-    Sah,
-    /// obvhs's PLOC with reinsertion.
-    Ploc,
-}
-
-impl Builder {
-    /// The builder of a command-line name.
-    pub fn from_name(name: &str) -> Result<Builder, String> {
-        match name {
-            "sah" => Ok(Builder::Sah),
-            "ploc" => Ok(Builder::Ploc),
-            other => Err(format!("unknown builder '{other}' (known: sah, ploc)")),
-        }
-    }
-
-    /// Command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Builder::Sah => "sah",
-            Builder::Ploc => "ploc",
-        }
-    }
-
-    /// Builds the canonical tree of `scene`.
-    pub fn build(self, scene: &Scene) -> Result<Bvh2, raytrail_core::Error> {
-        match self {
-            Builder::Sah => SahBuilder::default().build(scene.triangles()),
-            Builder::Ploc => raytrail_cpu::ploc::build_ploc(scene.triangles(), 63),
-        }
-    }
-}
 
 /// Name of the built-in scene.
 pub const BUILTIN_SCENE: &str = "builtin";

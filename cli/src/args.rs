@@ -218,8 +218,8 @@ pub struct AccuracyArgs {
     /// Camera views: outside, inside, both, or auto (inside too where it sees a room)
     #[arg(long, default_value = "auto", value_parser = ["outside", "inside", "both", "auto"])]
     pub view: String,
-    /// BVH2 builder
-    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
+    #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
     /// Also write the results as JSON
     #[arg(long, value_name = "FILE")]
@@ -260,7 +260,7 @@ impl LoadFlags {
 }
 
 /// The BVH2 builders by command-line name.
-pub const BUILDERS: [&str; 2] = ["sah", "ploc"];
+pub const BUILDERS: [&str; 3] = [Builder::ALL[0].name(), Builder::ALL[1].name(), Builder::ALL[2].name()];
 
 /// The name that asks for the method to be chosen by timing candidates on a sample of the rays
 /// (`raytrail::analysis`).
@@ -292,8 +292,8 @@ pub struct RunArgs {
     /// Scene file, or `builtin`
     #[arg(long, short = 's', value_name = "FILE", default_value = BUILTIN_SCENE)]
     pub scene: String,
-    /// BVH2 builder
-    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
+    #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
     /// Primary image width
     #[arg(long, short = 'W', default_value_t = 320, value_parser = clap::value_parser!(u32).range(1..))]
@@ -338,8 +338,8 @@ pub struct TraceArgs {
     /// Any-hit (occlusion) queries instead of closest-hit
     #[arg(long)]
     pub any: bool,
-    /// BVH2 builder
-    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
+    #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
     /// Möller-Trumbore triangle test instead of the watertight one
     #[arg(long)]
@@ -377,8 +377,8 @@ pub struct ExplainArgs {
     /// Also write the analysis as JSON
     #[arg(long, value_name = "FILE")]
     pub json: Option<String>,
-    /// BVH2 builder
-    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
+    #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
     /// Width of the generated primary image
     #[arg(long, short = 'W', default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..))]
@@ -459,8 +459,8 @@ pub struct RenderArgs {
     /// the CPU
     #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
     pub backend: String,
-    /// BVH2 builder
-    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
+    #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
     /// Ambient-occlusion rays per pixel (--mode ao)
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=256))]

@@ -39,8 +39,8 @@ pub fn main(a: ExplainArgs) -> Outcome {
     let scene = &named.scene;
     crate::args::ploc_note(builder, scene);
     let (bvh, build_s) =
-        timed(&format!("building the BVH2 ({} triangles)", scene.triangles().len()), || builder.build(scene));
-    let bvh = bvh.map_err(|e| e.to_string())?;
+        timed(&format!("building the BVH2 ({} triangles)", scene.triangles().len()), || builder.build_choosing(scene));
+    let (bvh, made_by) = bvh.map_err(|e| e.to_string())?;
     let backend = CpuBackend::new();
     let sets = match &a.rays {
         Some(path) => {
@@ -57,7 +57,7 @@ pub fn main(a: ExplainArgs) -> Outcome {
     let mut progress = Progress::new("analysing", Part::ALL.len() + sets.len());
     let analysis = analyze(scene, &bvh, &sets, &backend, &mut |what| progress.step(what)).map_err(|e| e.to_string())?;
     progress.finish();
-    print(&named.name, builder.name(), build_s, &analysis);
+    print(&named.name, &builder.label(made_by), build_s, &analysis);
     if let Some(path) = &a.json {
         let text = serde_json::to_string_pretty(&to_json(&named.name, &analysis)).map_err(|e| e.to_string())?;
         write_atomically(path, |w| w.write_all(text.as_bytes())).map_err(|e| format!("cannot write {path}: {e}"))?;

@@ -108,7 +108,7 @@ fn method_is_optional_with_its_default_shown() {
 #[test]
 fn defaults_are_shown() {
     let help = text(&run(&["run", "--help"]).stdout);
-    for d in ["[default: builtin]", "[default: sah]", "[default: 320]", "[default: 240]", "[default: 5]"] {
+    for d in ["[default: builtin]", "[default: best]", "[default: 320]", "[default: 240]", "[default: 5]"] {
         assert!(help.contains(d), "run: {d}: {help}");
     }
     let help = text(&run(&["bench", "--help"]).stdout);

@@ -33,6 +33,7 @@ use raytrail::core::trace::Trace;
 use raytrail::core::Hit;
 use raytrail::cpu::CpuScene;
 use raytrail::gpu::WgpuBackend;
+use raytrail::Builder;
 use raytrail_cli::write::write_atomically;
 use report::{BenchReport, Built, SceneReport};
 use std::io::Write;
@@ -129,9 +130,9 @@ fn bench_scene(
 
     let (bvh, tree_s) = timed(
         &format!("building raytrail's BVH2 ({}, {} triangles)", opts.builder.name(), scene.triangles().len()),
-        || largest.install(|| opts.builder.build(scene)),
+        || largest.install(|| opts.builder.build_choosing(scene)),
     );
-    let bvh = bvh.map_err(|e| format!("{}: {e}", named.name))?;
+    let (bvh, made_by) = bvh.map_err(|e| format!("{}: {e}", named.name))?;
     // The stack method always takes part: it makes the secondary rays and the reference hits.
     let mut methods = opts.methods.clone();
     if !methods.contains(&Method::Bvh2(Bvh2Method::Stack)) {
@@ -145,7 +146,7 @@ fn bench_scene(
         largest.install(|| PreparedScene::new(scene, bvh, &methods))
     });
     let prepared = Arc::new(prepared.map_err(|e| format!("{}: {e}", named.name))?);
-    let mut builds = raytrail_builds(opts, tree_s, &prepared);
+    let mut builds = raytrail_builds(opts.builder, made_by, tree_s, &prepared);
     let cpu = CpuScene(prepared);
 
     let stack = RaytrailCpu::new(Method::Bvh2(Bvh2Method::Stack), cpu.clone());
@@ -260,10 +261,11 @@ fn print_auto_choices(
     }
 }
 
-/// raytrail's build steps and the memory of each part it derived.
-fn raytrail_builds(opts: &Options, tree_s: f64, p: &PreparedScene) -> Vec<Built> {
-    let mut out =
-        vec![Built { what: format!("raytrail BVH2 ({})", opts.builder.name()), seconds: tree_s, bytes: vec![] }];
+/// raytrail's build steps and the memory of each part it derived; `made_by` is the builder whose
+/// tree `asked` kept (itself, but for `best`).
+fn raytrail_builds(asked: Builder, made_by: Builder, tree_s: f64, p: &PreparedScene) -> Vec<Built> {
+    let what = format!("raytrail BVH2 ({})", asked.label(made_by));
+    let mut out = vec![Built { what, seconds: tree_s, bytes: vec![] }];
     let mut layout_bytes = Vec::new();
     for (name, layout) in [("uncle", &p.uncles), ("parent/sibling", &p.parents)] {
         if let Some(l) = layout {

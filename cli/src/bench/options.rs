@@ -113,8 +113,8 @@ pub struct BenchArgs {
     /// Also write an SVG plot of the results
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<String>,
-    /// BVH2 builder of raytrail's tree
-    #[arg(long, default_value = "sah", value_parser = BUILDERS)]
+    /// BVH2 builder of raytrail's tree: `best` builds with both and keeps the lower SAH cost
+    #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
     /// Ambient-occlusion rays per primary hit (1 to 64)
     #[arg(long, default_value_t = DEFAULT_AO_RAYS)]
@@ -434,7 +434,7 @@ mod tests {
             "--threads 0",
             "--passes 0",
             "--width 0",
-            "--builder best",
+            "--builder fastest",
             "--methods none --peers none",
             "--ao-rays 0",
         ] {

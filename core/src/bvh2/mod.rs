@@ -1,7 +1,8 @@
 //! Binary bounding volume hierarchies: the canonical tree, its builders and its node layouts.
 //!
 //! - [`Bvh2`]: the canonical tree, the single source of truth (node identity = index, pre-order).
-//! - [`SahBuilder`]: a binned SAH builder (needs `alloc`).
+//! - [`SahBuilder`]: a binned SAH builder (needs `alloc`); [`SahConfig::tree_cost`] prices a
+//!   finished tree, whoever built it.
 //! - [`BinaryLayout`]: the Aila-Laine layout (both child boxes in the parent, leaf triangle arrays
 //!   closed by a termination marker) with uncle or parent/sibling links in the padding.
 //! - [`BvhMemory`]: the narrow read interface traversals use.
@@ -13,6 +14,8 @@ pub mod traverse;
 pub use memory::{BvhMemory, MemRead, SliceMemory};
 pub use node::{BinaryNode, LeafWord, NodeRef};
 
+#[cfg(feature = "alloc")]
+mod cost;
 #[cfg(feature = "alloc")]
 mod layout;
 #[cfg(feature = "alloc")]
