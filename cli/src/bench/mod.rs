@@ -26,6 +26,7 @@ pub mod view;
 use crate::args::{check_input, check_output, Failure, Outcome};
 use crate::progress::{timed, Progress};
 use options::Options;
+use raytrail::core::bvh2::SahConfig;
 use raytrail::core::mesh::LoadOptions;
 use raytrail::core::method::{Bvh2Method, Method, Query};
 use raytrail::core::prepared::PreparedScene;
@@ -262,9 +263,12 @@ fn print_auto_choices(
 }
 
 /// raytrail's build steps and the memory of each part it derived; `made_by` is the builder whose
-/// tree `asked` kept (itself, but for `best`).
+/// tree `asked` kept (itself, but for `best`). The tree's SAH cost, what `best` compares, is shown
+/// whatever the builder, so that runs with `--builder sah` and `--builder ploc` show what `best`
+/// weighed.
 fn raytrail_builds(asked: Builder, made_by: Builder, tree_s: f64, p: &PreparedScene) -> Vec<Built> {
-    let what = format!("raytrail BVH2 ({})", asked.label(made_by));
+    let cost = SahConfig::default().tree_cost(&p.bvh);
+    let what = format!("raytrail BVH2 ({}; SAH cost {cost:.2})", asked.label(made_by));
     let mut out = vec![Built { what, seconds: tree_s, bytes: vec![] }];
     let mut layout_bytes = Vec::new();
     for (name, layout) in [("uncle", &p.uncles), ("parent/sibling", &p.parents)] {
