@@ -63,10 +63,8 @@ impl Builder {
             Builder::Ploc => Ok((raytrail_cpu::ploc::build_ploc(scene.triangles(), 63)?, Builder::Ploc)),
             Builder::Best => {
                 let sah = SahBuilder::default().build(scene.triangles())?;
-                // Where PLOC would hand the scene to the SAH builder anyway, one tree is enough.
-                if raytrail_cpu::ploc::ploc_fallback(scene.triangles()).is_some() {
-                    return Ok((sah, Builder::Sah));
-                }
+                // Where PLOC hands the scene to the SAH builder (coincident triangles), its tree is
+                // this one and the tie keeps it; asking first would sort every scene's boxes twice.
                 let ploc = raytrail_cpu::ploc::build_ploc(scene.triangles(), 63)?;
                 Ok(cheaper(sah, ploc))
             }
@@ -156,6 +154,22 @@ mod tests {
         assert_eq!(cheaper(poor.clone(), good.clone()).1, Builder::Ploc);
         assert_eq!(cheaper(good.clone(), poor).1, Builder::Sah);
         assert_eq!(cheaper(good.clone(), good).1, Builder::Sah, "a tie keeps the SAH tree");
+    }
+
+    #[test]
+    fn coincident_triangles_keep_the_sah_tree() {
+        // More points at one place than PLOC takes: it hands them to the SAH builder, and the
+        // tie between the two identical trees keeps SAH's.
+        // At the origin, where PLOC's tie-breaking margins are zero.
+        let p = Vec3::ZERO;
+        let mut t = vec![Triangle::new(p, p, p); raytrail_cpu::ploc::MAX_TIED + 44];
+        t.push(Triangle::new(Vec3::ONE, Vec3::new(2.0, 1.0, 1.0), Vec3::new(1.0, 2.0, 1.0)));
+        let s = Scene::new(t).unwrap();
+        assert!(raytrail_cpu::ploc::ploc_fallback(s.triangles()).is_some());
+        let (best, kept) = Builder::Best.build_choosing(&s).unwrap();
+        assert_eq!(kept, Builder::Sah);
+        let sah = SahBuilder::default().build(s.triangles()).unwrap();
+        assert_eq!(best.nodes().len(), sah.nodes().len());
     }
 
     #[test]
