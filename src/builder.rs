@@ -2,6 +2,7 @@
 
 use raytrail_core::bvh2::{Bvh2, SahBuilder, SahConfig};
 use raytrail_core::scene::Scene;
+use raytrail_cpu::ploc::{build_ploc, MAX_KEY_DEPTH};
 
 /// Which builder makes the canonical tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -60,12 +61,12 @@ impl Builder {
     pub fn build_choosing(self, scene: &Scene) -> Result<(Bvh2, Builder), raytrail_core::Error> {
         match self {
             Builder::Sah => Ok((SahBuilder::default().build(scene.triangles())?, Builder::Sah)),
-            Builder::Ploc => Ok((raytrail_cpu::ploc::build_ploc(scene.triangles(), 63)?, Builder::Ploc)),
+            Builder::Ploc => Ok((build_ploc(scene.triangles(), MAX_KEY_DEPTH)?, Builder::Ploc)),
             Builder::Best => {
                 let sah = SahBuilder::default().build(scene.triangles())?;
                 // Where PLOC hands the scene to the SAH builder (coincident triangles), its tree is
                 // this one and the tie keeps it; asking first would sort every scene's boxes twice.
-                let ploc = raytrail_cpu::ploc::build_ploc(scene.triangles(), 63)?;
+                let ploc = build_ploc(scene.triangles(), MAX_KEY_DEPTH)?;
                 Ok(cheaper(sah, ploc))
             }
         }
