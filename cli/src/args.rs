@@ -67,7 +67,8 @@ pub fn usage<T>(m: impl Into<String>) -> Result<T, Failure> {
 const AFTER_HELP: &str = "\
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
          kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree);
-         bvh4, bvh8, bvh4-naive, bvh8-sah, bvh8-packet, bvh8-stream, bvh4-hash (wide BVH);
+         bvh4, bvh8, bvh4-naive, bvh8-sah, bvh8-packet, bvh8-stream, bvh4-hash, bvh8-sah-packet,
+         bvh8-sah-stream (wide BVH);
          stream (ray stream, Garanzha & Loop);
          auto (trace's default; bench --methods): the fastest of bvh8, bvh8-packet, kd-stack, stack
          and stream

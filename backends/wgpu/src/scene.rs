@@ -4,7 +4,7 @@
 use crate::device::{device_error, Gpu};
 use crate::workspace::Workspace;
 use raytrail_core::bvh2::{BinaryLayout, LeafWord};
-use raytrail_core::method::{Bvh2Method, WideMethod};
+use raytrail_core::method::{Bvh2Method, WideMethod, WideTreeKind};
 use raytrail_core::prepared::{BuiltHash, PreparedScene};
 use raytrail_core::wide::WideBvh;
 use raytrail_core::Error;
@@ -253,11 +253,11 @@ impl WgpuScene {
 
     /// The wide tree buffer `method` reads.
     pub(crate) fn wide_for(&self, method: WideMethod) -> Option<&WideBuffer> {
-        match method {
-            WideMethod::Bvh4 | WideMethod::Bvh4Hash => self.wide4.as_ref(),
-            WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream => self.wide8.as_ref(),
-            WideMethod::Bvh4Naive => self.wide4_naive.as_ref(),
-            WideMethod::Bvh8Sah => self.wide8_sah.as_ref(),
+        match method.tree() {
+            WideTreeKind::Four => self.wide4.as_ref(),
+            WideTreeKind::Eight => self.wide8.as_ref(),
+            WideTreeKind::FourNaive => self.wide4_naive.as_ref(),
+            WideTreeKind::EightSah => self.wide8_sah.as_ref(),
         }
     }
 

@@ -16,7 +16,7 @@ pub use bvh2::Bvh2Method;
 pub use kd::KdMethod;
 pub use query::Query;
 pub use stream::StreamMethod;
-pub use wide::{Collapse, WideMethod};
+pub use wide::{Collapse, WideMethod, WideTreeKind};
 
 use crate::Error;
 use core::fmt;

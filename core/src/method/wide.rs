@@ -33,6 +33,45 @@ pub enum WideMethod {
     /// Binder & Keller's node keys, bit trail and perfect hash at two key bits per level, a
     /// backtrack being one hash lookup and the parent's box tests again. Beyond both papers.
     Bvh4Hash,
+    /// [`WideMethod::Bvh8Sah`]'s tree walked by packets, as [`WideMethod::Bvh8Packet`] walks the
+    /// pull-up's: the cut of least node area serves closest-hit packets better and shadow-ray
+    /// packets worse (BENCHMARKS.md, "Packets and streams on the SAH-optimal cut").
+    Bvh8SahPacket,
+    /// [`WideMethod::Bvh8Sah`]'s tree walked by ray streams, as [`WideMethod::Bvh8Stream`] walks
+    /// the pull-up's (for incoherent closest-hit rays, as there).
+    Bvh8SahStream,
+}
+
+/// The wide trees a scene may hold: methods that name the same one share it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum WideTreeKind {
+    /// Four children per node by the pull-up.
+    Four,
+    /// Four children per node with every second level removed.
+    FourNaive,
+    /// Eight children per node by the pull-up.
+    Eight,
+    /// Eight children per node by the SAH-optimal cut.
+    EightSah,
+}
+
+impl WideTreeKind {
+    /// Children per node.
+    pub fn width(self) -> usize {
+        match self {
+            WideTreeKind::Four | WideTreeKind::FourNaive => 4,
+            WideTreeKind::Eight | WideTreeKind::EightSah => 8,
+        }
+    }
+
+    /// How the tree is collapsed from the binary one.
+    pub fn collapse(self) -> Collapse {
+        match self {
+            WideTreeKind::Four | WideTreeKind::Eight => Collapse::PullUp,
+            WideTreeKind::FourNaive => Collapse::EverySecondLevel,
+            WideTreeKind::EightSah => Collapse::Optimal,
+        }
+    }
 }
 
 /// How a wide tree is collapsed from the binary one.
@@ -49,7 +88,7 @@ pub enum Collapse {
 
 impl WideMethod {
     /// Every wide method.
-    pub const ALL: [WideMethod; 7] = [
+    pub const ALL: [WideMethod; 9] = [
         WideMethod::Bvh4,
         WideMethod::Bvh8,
         WideMethod::Bvh4Naive,
@@ -57,6 +96,8 @@ impl WideMethod {
         WideMethod::Bvh8Packet,
         WideMethod::Bvh8Stream,
         WideMethod::Bvh4Hash,
+        WideMethod::Bvh8SahPacket,
+        WideMethod::Bvh8SahStream,
     ];
 
     /// Command-line name.
@@ -69,38 +110,39 @@ impl WideMethod {
             WideMethod::Bvh8Packet => "bvh8-packet",
             WideMethod::Bvh8Stream => "bvh8-stream",
             WideMethod::Bvh4Hash => "bvh4-hash",
+            WideMethod::Bvh8SahPacket => "bvh8-sah-packet",
+            WideMethod::Bvh8SahStream => "bvh8-sah-stream",
+        }
+    }
+
+    /// The tree the method walks.
+    pub fn tree(self) -> WideTreeKind {
+        match self {
+            WideMethod::Bvh4 | WideMethod::Bvh4Hash => WideTreeKind::Four,
+            WideMethod::Bvh4Naive => WideTreeKind::FourNaive,
+            WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream => WideTreeKind::Eight,
+            WideMethod::Bvh8Sah | WideMethod::Bvh8SahPacket | WideMethod::Bvh8SahStream => WideTreeKind::EightSah,
         }
     }
 
     /// Children per node.
     pub fn width(self) -> usize {
-        match self {
-            WideMethod::Bvh4 | WideMethod::Bvh4Naive | WideMethod::Bvh4Hash => 4,
-            WideMethod::Bvh8 | WideMethod::Bvh8Sah | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream => 8,
-        }
+        self.tree().width()
     }
 
     /// How the method's tree is collapsed.
     pub fn collapse(self) -> Collapse {
-        match self {
-            WideMethod::Bvh4
-            | WideMethod::Bvh8
-            | WideMethod::Bvh8Packet
-            | WideMethod::Bvh8Stream
-            | WideMethod::Bvh4Hash => Collapse::PullUp,
-            WideMethod::Bvh8Sah => Collapse::Optimal,
-            WideMethod::Bvh4Naive => Collapse::EverySecondLevel,
-        }
+        self.tree().collapse()
     }
 
     /// Whether rays are traced in packets ([`crate::wide::packet`]) rather than one at a time.
     pub fn packets(self) -> bool {
-        self == WideMethod::Bvh8Packet
+        matches!(self, WideMethod::Bvh8Packet | WideMethod::Bvh8SahPacket)
     }
 
     /// Whether rays are traced in streams ([`crate::wide::ray_stream`]) rather than one at a time.
     pub fn streams(self) -> bool {
-        self == WideMethod::Bvh8Stream
+        matches!(self, WideMethod::Bvh8Stream | WideMethod::Bvh8SahStream)
     }
 
     /// Whether several rays share one walk of the tree (packets or streams): such a method's

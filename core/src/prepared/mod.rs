@@ -16,7 +16,7 @@ use crate::hash::{keys_to_hash, HashCoverage, HashShape, HashStats, PerfectHash}
 use crate::kd::traverse::KdRoot;
 use crate::kd::{KdBuilder, KdSliceMemory, KdTree};
 use crate::key::KeyWidth;
-use crate::method::{Bvh2Method, Method, StreamMethod, Structure, WideMethod};
+use crate::method::{Bvh2Method, Method, StreamMethod, Structure, WideMethod, WideTreeKind};
 use crate::scene::Scene;
 use crate::stream::{LevelBvh, StreamScene};
 use crate::wide::keyed::{keyed_nodes, WideHashedMemory};
@@ -97,12 +97,13 @@ pub struct PreparedScene {
     /// none: a tree deeper than 64-bit keys allow ([`Error::TreeTooDeep`], which only that
     /// method then returns).
     pub wide4_hash: Option<Result<KeyedHash, Error>>,
-    /// The 8-wide tree by the pull-up ([`WideMethod::Bvh8`], [`WideMethod::Bvh8Packet`],
-    /// [`WideMethod::Bvh8Stream`]).
+    /// The 8-wide tree by the pull-up ([`WideTreeKind::Eight`]: [`WideMethod::Bvh8`] and its
+    /// packets and streams).
     pub wide8: Option<WideBvh<8>>,
     /// The 4-wide tree with every second level removed ([`WideMethod::Bvh4Naive`]).
     pub wide4_naive: Option<WideBvh<4>>,
-    /// The 8-wide tree by the SAH-optimal cut ([`WideMethod::Bvh8Sah`]).
+    /// The 8-wide tree by the SAH-optimal cut ([`WideTreeKind::EightSah`]: [`WideMethod::Bvh8Sah`]
+    /// and its packets and streams).
     pub wide8_sah: Option<WideBvh<8>>,
     /// The 8-wide tree laid out level by level ([`StreamMethod::Frustum8`]).
     pub levels: Option<LevelBvh>,
@@ -172,18 +173,19 @@ impl PreparedScene {
         timings.kd = seconds_since(Some(t3));
         let t4 = seconds_since(None);
         let wants = |w: WideMethod| methods.contains(&Method::Wide(w));
+        let wants_tree = |k: WideTreeKind| methods.iter().any(|m| m.wide().is_some_and(|w| w.tree() == k));
         let (wide4, wide8, wide4_naive, wide8_sah) = (
-            (wants(WideMethod::Bvh4) || wants(WideMethod::Bvh4Hash))
-                .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4.collapse()))
+            wants_tree(WideTreeKind::Four)
+                .then(|| WideBvh::build(&bvh, tris, WideTreeKind::Four.collapse()))
                 .transpose()?,
-            (wants(WideMethod::Bvh8) || wants(WideMethod::Bvh8Packet) || wants(WideMethod::Bvh8Stream))
-                .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse()))
+            wants_tree(WideTreeKind::Eight)
+                .then(|| WideBvh::build(&bvh, tris, WideTreeKind::Eight.collapse()))
                 .transpose()?,
-            wants(WideMethod::Bvh4Naive)
-                .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh4Naive.collapse()))
+            wants_tree(WideTreeKind::FourNaive)
+                .then(|| WideBvh::build(&bvh, tris, WideTreeKind::FourNaive.collapse()))
                 .transpose()?,
-            wants(WideMethod::Bvh8Sah)
-                .then(|| WideBvh::build(&bvh, tris, WideMethod::Bvh8Sah.collapse()))
+            wants_tree(WideTreeKind::EightSah)
+                .then(|| WideBvh::build(&bvh, tris, WideTreeKind::EightSah.collapse()))
                 .transpose()?,
         );
         timings.wide = seconds_since(Some(t4));
@@ -300,13 +302,11 @@ impl PreparedScene {
     /// The wide tree `method` traverses, of its width.
     pub fn wide_tree(&self, method: WideMethod) -> Result<WideTree<'_>, Error> {
         let missing = || Error::NotPrepared { method: method.name(), missing: "its wide tree" };
-        Ok(match method {
-            WideMethod::Bvh4 | WideMethod::Bvh4Hash => WideTree::Four(self.wide4.as_ref().ok_or_else(missing)?),
-            WideMethod::Bvh4Naive => WideTree::Four(self.wide4_naive.as_ref().ok_or_else(missing)?),
-            WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream => {
-                WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?)
-            }
-            WideMethod::Bvh8Sah => WideTree::Eight(self.wide8_sah.as_ref().ok_or_else(missing)?),
+        Ok(match method.tree() {
+            WideTreeKind::Four => WideTree::Four(self.wide4.as_ref().ok_or_else(missing)?),
+            WideTreeKind::FourNaive => WideTree::Four(self.wide4_naive.as_ref().ok_or_else(missing)?),
+            WideTreeKind::Eight => WideTree::Eight(self.wide8.as_ref().ok_or_else(missing)?),
+            WideTreeKind::EightSah => WideTree::Eight(self.wide8_sah.as_ref().ok_or_else(missing)?),
         })
     }
 

@@ -2,7 +2,7 @@
 //! the parts no remaining method reads.
 
 use super::PreparedScene;
-use crate::method::{Bvh2Method, Method, StreamMethod, WideMethod};
+use crate::method::{Bvh2Method, Method, StreamMethod, WideMethod, WideTreeKind};
 use core::fmt;
 
 /// One table (or set of tables) [`PreparedScene::new`] derives from the canonical tree. The
@@ -75,11 +75,13 @@ impl Part {
             Method::Bvh2(Bvh2Method::HashResume) => &[Part::UncleLayout, Part::FullHash],
             Method::Bvh2(_) => &[Part::UncleLayout],
             Method::Kd(_) => &[Part::Kd],
-            Method::Wide(WideMethod::Bvh4) => &[Part::Wide4],
             Method::Wide(WideMethod::Bvh4Hash) => &[Part::Wide4, Part::Wide4Hash],
-            Method::Wide(WideMethod::Bvh8 | WideMethod::Bvh8Packet | WideMethod::Bvh8Stream) => &[Part::Wide8],
-            Method::Wide(WideMethod::Bvh4Naive) => &[Part::Wide4Naive],
-            Method::Wide(WideMethod::Bvh8Sah) => &[Part::Wide8Sah],
+            Method::Wide(m) => match m.tree() {
+                WideTreeKind::Four => &[Part::Wide4],
+                WideTreeKind::FourNaive => &[Part::Wide4Naive],
+                WideTreeKind::Eight => &[Part::Wide8],
+                WideTreeKind::EightSah => &[Part::Wide8Sah],
+            },
             Method::Stream(StreamMethod::Frustum8) => &[Part::Levels],
         }
     }

@@ -22,7 +22,7 @@ USAGE:
               bvh2: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume
               kd: kd-stack, kd-restart, kd-push-down, kd-short-stack (kd-packet is not simulated:
                   a packet of four rays is a lockstep unit of its own)
-              wide: bvh4, bvh8, bvh4-naive, bvh8-sah (bvh8-packet and bvh8-stream are not simulated, as kd-packet)
+              wide: bvh4, bvh8, bvh4-naive, bvh8-sah (the packet and stream methods are not simulated, as kd-packet)
               stream: Garanzha & Loop's sorted packets, modelled per warp of a packet's rays,
                   sorted and (for comparison) packed in input order
   --timeline  also print the slowest warp's cycles for METHOD, one symbol per lane:

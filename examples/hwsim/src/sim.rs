@@ -229,7 +229,7 @@ pub struct MethodRun {
 
 /// Simulates `method` over `rays` in lockstep warps, with the watertight triangle test: any BVH2
 /// method (with the key width the tree needs), the kd methods but the packet one, and every wide
-/// method but the packet, stream and keyed ones. kd-packet, bvh8-packet and bvh8-stream are
+/// method but the packet, stream and keyed ones. kd-packet and the wide packet and stream methods are
 /// lockstep units of their own (rays sharing a node) and bvh4-hash runs as one loop per ray, not a step function;
 /// they are an [`Error::Unsupported`], as is a method `prepared` lacks the tables of
 /// ([`Error::NotPrepared`]).
