@@ -12,7 +12,9 @@
 # bvh8-packet against the old side's bvh8); AB_TRAV, AB_MAXLEAF, AB_BLOCK, AB_BINS change the new
 # side's SAH settings (to try a builder change without editing it); AB_FRESH=0 keeps one copy of each tree for all
 # rounds (by default each round traces fresh copies, so that where the trees land in physical
-# memory, which moved a set by up to 25% between runs, averages out).
+# memory, which moved a set by up to 25% between runs, averages out). AB_COUNT=N traces each set
+# N times with the new side alone, untimed, and AB_RUNNER prefixes the harness's command line:
+# both for scripts/instr-profile.sh.
 # The old commit is checked out in a temporary worktree with its two crates renamed, so both link
 # into one binary.
 set -euo pipefail
@@ -43,7 +45,11 @@ oc = { path = "$old/core", package = "raytrail-core-old" }
 ocpu = { path = "$old/backends/cpu", package = "raytrail-cpu-old" }
 glam = "0.34"
 
+# As the workspace's release profile: line tables for profilers, the same code.
+[profile.release]
+debug = 1
+
 [workspace]
 TOML
 CARGO_TARGET_DIR="$root/target" cargo build --release --quiet --manifest-path "$harness/Cargo.toml"
-"$root/target/release/raytrail-ab" "$@"
+${AB_RUNNER:-} "$root/target/release/raytrail-ab" "$@"

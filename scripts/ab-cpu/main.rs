@@ -15,6 +15,23 @@ fn die(msg: String) -> ! {
     std::process::exit(2)
 }
 
+/// Traces `rays` `times` times with the new side: with `AB_COUNT`, the one function
+/// `scripts/instr-profile.sh` has callgrind count instructions in.
+#[inline(never)]
+fn counted(
+    b: &rcpu::CpuBackend,
+    s: &rcpu::CpuScene,
+    rays: &[rc::Ray],
+    opts: &rc::trace::TraceOptions,
+    hits: &mut [rc::Hit],
+    times: usize,
+) {
+    use rc::trace::Trace;
+    for _ in 0..times {
+        b.trace(s, rays, opts, hits).unwrap();
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let Some(path) = args.get(1) else { die("usage: SCENE [VIEW] [METHOD] [ROUNDS] [SETS]".into()) };
@@ -112,6 +129,12 @@ fn main() {
         let oopts = oc::trace::TraceOptions::new(om).query(oq);
         let mut nh = vec![rc::Hit::MISS; rays.len()];
         let mut oh = vec![oc::Hit::MISS; rays.len()];
+        if let Some(times) = std::env::var("AB_COUNT").ok().and_then(|v| v.parse::<usize>().ok()) {
+            newb.trace(&ns, rays, &nopts, &mut nh).unwrap();
+            counted(&newb, &ns, rays, &nopts, &mut nh, times);
+            println!("{name:8} {:>8} rays traced {times} times (AB_COUNT) by the new side", rays.len());
+            continue;
+        }
         let (mut tn, mut to) = (Vec::new(), Vec::new());
         for r in 0..rounds + 1 {
             if fresh && r > 0 {
