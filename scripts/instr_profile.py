@@ -13,6 +13,15 @@ import subprocess
 import sys
 
 
+def step(tok, cur):
+    """A callgrind position: absolute, relative to the last (+n, -n), or the same (*)."""
+    if tok == "*":
+        return cur
+    if tok[0] in "+-":
+        return cur + int(tok)
+    return int(tok, 0)
+
+
 def per_instruction(path):
     """Ir and Bcm per instruction address, and (file, line) per address, from a callgrind file
     with `positions: instr line` (addresses and lines may be relative: +n, -n, or * for same)."""
@@ -41,13 +50,6 @@ def per_instruction(path):
         parts = s.split()
         if len(parts) < 2:
             continue
-
-        def step(tok, cur):
-            if tok == "*":
-                return cur
-            if tok[0] in "+-":
-                return cur + int(tok)
-            return int(tok, 0)
 
         addr, line = step(parts[0], addr), step(parts[1], line)
         if skip_call_cost:

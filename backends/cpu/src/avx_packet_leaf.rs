@@ -296,6 +296,7 @@ unsafe fn triangle(r: &RayLanes, v: *const f32) -> TriangleLanes {
 
 #[cfg(test)]
 mod tests {
+    use super::{shear_lanes, RayLanes};
     use crate::avx::AvxKernel;
     use crate::test_rng::Rng;
     use glam::Vec3;
@@ -412,5 +413,54 @@ mod tests {
         }
         assert!(hits > 10_000, "only {hits} hits");
         assert!(answered_early > 1_000, "only {answered_early} any-hit rays answered before the leaf's end");
+    }
+
+    /// `shear_lanes` against `Watertight::prepare`, lane by lane and bit for bit, on directions
+    /// with zeros of both signs, exact ties between components (which pick the lower axis) and
+    /// every sign: the axis order, the origin in that order and the shear.
+    #[test]
+    fn lane_constants_are_each_rays_own() {
+        if !crate::avx::available() {
+            eprintln!("SKIPPED the AVX2 lane constants test: this processor has no AVX2");
+            return;
+        }
+        use raytrail_core::intersect::TriangleTest;
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let (mut checked, mut axes_seen) = (0, [0usize; 3]);
+        for _ in 0..20_000 {
+            let (mut dir, mut org) = ([[1.0f32; 8]; 3], [[0.0f32; 8]; 3]);
+            let mut rays = [None; 8];
+            for (k, slot) in rays.iter_mut().enumerate() {
+                let d = [rng.value(), rng.value(), rng.value()];
+                let o = [rng.value(), rng.value(), rng.value()];
+                if d.iter().all(|&x| x == 0.0) {
+                    continue;
+                }
+                for a in 0..3 {
+                    (dir[a][k], org[a][k]) = (d[a], o[a]);
+                }
+                *slot = Some(Ray { origin: o, tmin: 0.0, dir: d, tmax: f32::INFINITY });
+            }
+            let mut r = RayLanes {
+                origin: [[0.0; 8]; 3],
+                shear: [[0.0; 8]; 3],
+                axes: [[0; 8]; 3],
+                tmin: [0.0; 8],
+                tmax: [0.0; 8],
+            };
+            // SAFETY: AVX2 checked above.
+            unsafe { shear_lanes(&dir, &org, &mut r) };
+            for (k, ray) in rays.iter().enumerate() {
+                let Some(ray) = ray else { continue };
+                let want = Watertight::prepare(ray);
+                let lane = |v: &[[f32; 8]; 3]| [v[0][k], v[1][k], v[2][k]].map(f32::to_bits);
+                assert_eq!(lane(&r.origin), want.origin().map(f32::to_bits), "{ray:?}");
+                assert_eq!(lane(&r.shear), want.shear().map(f32::to_bits), "{ray:?}");
+                assert_eq!([r.axes[0][k], r.axes[1][k], r.axes[2][k]], want.axes().map(|a| a as i32), "{ray:?}");
+                axes_seen[want.axes()[2]] += 1;
+                checked += 1;
+            }
+        }
+        assert!(checked > 100_000 && axes_seen.iter().all(|&n| n > 10_000), "{checked} {axes_seen:?}");
     }
 }
