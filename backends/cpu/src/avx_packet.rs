@@ -16,18 +16,20 @@ use raytrail_core::intersect::{TriangleTest, FAR_PAD};
 use raytrail_core::method::Query;
 use raytrail_core::observe::Observer;
 use raytrail_core::wide::packet::{
-    trace_wide_packets, Lanes, PacketHits, PacketKernel, PacketRays, ReferencePacketKernel,
+    trace_wide_packets, PacketHits, PacketKernel, PacketLanes, PacketRays, ReferencePacketKernel,
 };
 use raytrail_core::wide::traverse::WideRoot;
 use raytrail_core::wide::{ChildKernel, WideMemory, WideNode, EMPTY_CHILD};
 use raytrail_core::{Hit, Ray};
+
 use std::arch::x86_64::{
     __m256, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps256_ps128,
     _mm256_castps_si256, _mm256_castsi256_ps, _mm256_castsi256_si128, _mm256_cmp_ps, _mm256_cmpeq_epi32,
     _mm256_cvtepi32_epi64, _mm256_extractf128_ps, _mm256_extracti128_si256, _mm256_loadu_ps, _mm256_max_ps,
     _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_epi64x,
     _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_ps,
-    _mm_cvtss_f32, _mm_min_ps, _mm_min_ss, _mm_movehl_ps, _mm_shuffle_ps, _CMP_GT_OQ, _CMP_LE_OQ,
+    _mm_cvtss_f32, _mm_max_ps, _mm_max_ss, _mm_min_ps, _mm_min_ss, _mm_movehl_ps, _mm_shuffle_ps, _CMP_GT_OQ,
+    _CMP_LE_OQ,
 };
 
 /// The packet kernel of [`trace_batch`], used only there (and by the tests, after their own AVX2
@@ -46,6 +48,17 @@ impl PacketKernel for AvxPacketKernel {
         }
     }
 
+    /// Eight lanes per operation ([`crate::avx_packet_begin`]).
+    #[inline(always)]
+    fn begin<const N: usize>(rays: &[Ray], scene_scale: f32, lanes: &mut PacketLanes<N>) {
+        if N % 8 == 0 {
+            // SAFETY: as `test`.
+            unsafe { crate::avx_packet_begin::begin(rays, scene_scale, lanes) }
+        } else {
+            ReferencePacketKernel::begin(rays, scene_scale, lanes)
+        }
+    }
+
     /// With the rays in the lanes ([`crate::avx_packet_leaf`]) where the test is the watertight
     /// one; otherwise each ray alone.
     #[inline(always)]
@@ -54,7 +67,7 @@ impl PacketKernel for AvxPacketKernel {
         first: u32,
         count: u32,
         mask: u64,
-        lanes: &mut Lanes<T, N>,
+        lanes: &mut PacketLanes<N>,
         obs: &mut [O],
     ) where
         M: WideMemory<W> + ?Sized,
@@ -135,7 +148,7 @@ unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &Packe
         }
         if rays != 0 {
             out.rays[c % W] = rays;
-            out.key[c % W] = horizontal_min(key);
+            out.key[c % W] = horizontal(key, Fold::Min);
         }
     }
     out
@@ -205,13 +218,35 @@ unsafe fn slab_axis(
     (_mm256_max_ps(tn, t_enter), _mm256_min_ps(tf, t_exit))
 }
 
-/// The least lane of `v`.
-#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
+/// Which way [`horizontal`] folds.
+#[derive(Clone, Copy)]
+pub(crate) enum Fold {
+    /// To the least lane.
+    Min,
+    /// To the greatest lane.
+    Max,
+}
+
+/// The least or greatest of `v`'s eight lanes (none is NaN).
+///
+/// # Safety
+/// The processor must support AVX.
+#[target_feature(enable = "avx")]
 #[inline]
-unsafe fn horizontal_min(v: __m256) -> f32 {
-    let h = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
-    let h = _mm_min_ps(h, _mm_movehl_ps(h, h));
-    _mm_cvtss_f32(_mm_min_ss(h, _mm_shuffle_ps::<1>(h, h)))
+pub(crate) unsafe fn horizontal(v: __m256, fold: Fold) -> f32 {
+    let (low, high) = (_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
+    match fold {
+        Fold::Min => {
+            let h = _mm_min_ps(low, high);
+            let h = _mm_min_ps(h, _mm_movehl_ps(h, h));
+            _mm_cvtss_f32(_mm_min_ss(h, _mm_shuffle_ps::<1>(h, h)))
+        }
+        Fold::Max => {
+            let h = _mm_max_ps(low, high);
+            let h = _mm_max_ps(h, _mm_movehl_ps(h, h));
+            _mm_cvtss_f32(_mm_max_ss(h, _mm_shuffle_ps::<1>(h, h)))
+        }
+    }
 }
 
 /// The children some ray of the packet may hit (a bit per slot): the others are culled by the
@@ -273,8 +308,7 @@ mod tests {
     use super::*;
     use crate::test_rng::Rng;
     use glam::Vec3;
-    use raytrail_core::intersect::{NoPair, Watertight};
-    use raytrail_core::traverse::begin;
+    use raytrail_core::traverse::begin_slab;
     use raytrail_core::wide::WideChild;
 
     /// Packets of 32 rays, half of them of one octant (where the interval cull applies), against
@@ -307,8 +341,8 @@ mod tests {
                     dir,
                     tmax: [f32::INFINITY, 3.0][(rng.next() % 2) as usize],
                 };
-                let Some((ctx, q)) = begin::<Watertight, NoPair>(&ray, 8.0, Query::Closest) else { continue };
-                p.set_lane(i, &ctx, &q);
+                let Some(slab) = begin_slab(&ray, 8.0) else { continue };
+                p.set_lane(i, &slab, ray.tmin, ray.tmax);
                 if rng.next() % 4 != 0 {
                     mask |= 1 << i;
                 }

@@ -1,7 +1,8 @@
 //! A wide packet's leaf with the rays in the lanes: each triangle of the leaf against eight rays of
 //! the packet per AVX2 operation, where the single-ray test takes four triangles against one ray.
 //! A leaf that a packet reaches is reached by nine rays or more (fewer are handed over), so a
-//! triangle's loads and the test's chain of latencies are shared by eight rays.
+//! triangle's loads and the test's chain of latencies are shared by eight rays. The registers are
+//! the packet's own lanes (`PacketLanes`), eight at a time, loaded as they lie.
 //!
 //! Each lane is the watertight test of its own ray: its coordinates picked in the ray's own axis
 //! order (a per-lane permutation of the triangle's nine floats), then the SSE block test's
@@ -9,8 +10,9 @@
 //! eight lanes at once from the rays as given, not ray by ray: 1.16x on the kitchen's inside shadow
 //! rays, whose packets test one leaf each (601 to 536 instructions a ray; BENCHMARKS.md,
 //! "Instructions per ray"). A lane with a zero edge function, or with a hit the error bound flags,
-//! takes the scalar test. The answers are the single-ray leaf's bit for bit, and each ray's events
-//! come in its order (triangle by triangle, up to an any-hit answer).
+//! takes the scalar test, with its ray's constants made for it. The answers are the single-ray
+//! leaf's bit for bit, and each ray's events come in its order (triangle by triangle, up to an
+//! any-hit answer).
 //!
 //! The arithmetic is the SSE block test's (`raytrail_core`'s watertight test) written again for
 //! 256-bit registers. One form generic over the register width would call the AVX intrinsics from
@@ -19,14 +21,14 @@
 
 use raytrail_core::intersect::{TriangleHit, TriangleTest, REFINE_SCALE};
 use raytrail_core::observe::Observer;
-use raytrail_core::wide::packet::Lanes;
+use raytrail_core::wide::packet::PacketLanes;
 use raytrail_core::wide::WideMemory;
 use std::arch::x86_64::{
-    __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps, _mm256_blendv_ps,
-    _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_div_ps, _mm256_loadu_ps, _mm256_loadu_si256,
-    _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_permutevar8x32_ps, _mm256_set1_epi32, _mm256_set1_ps,
-    _mm256_setzero_ps, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_ps, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ,
-    _CMP_LT_OQ, _CMP_NEQ_UQ, _CMP_NGT_UQ, _CMP_NLT_UQ,
+    __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps,
+    _mm256_blendv_ps, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_div_ps,
+    _mm256_loadu_ps, _mm256_loadu_si256, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_permutevar8x32_ps,
+    _mm256_set1_epi32, _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_ps, _mm256_storeu_ps, _mm256_storeu_si256,
+    _mm256_sub_ps, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ, _CMP_NGT_UQ, _CMP_NLT_UQ,
 };
 
 /// Eight rays' watertight constants by lane.
@@ -53,8 +55,8 @@ struct TriangleLanes {
     v: [f32; 8],
 }
 
-/// Tests leaf `(first, count)` for the rays of `mask` with the rays in lanes, packed eight to a
-/// register in lane order, where `T` is the watertight test; `None` (nothing done) otherwise.
+/// Tests leaf `(first, count)` for the rays of `mask` with the rays in lanes, eight lanes of the
+/// packet to a register, where `T` is the watertight test; `None` (nothing done) otherwise.
 ///
 /// # Safety
 /// The processor must run the AVX2 path ([`crate::avx::available`]).
@@ -65,7 +67,7 @@ pub(crate) unsafe fn leaf<const W: usize, const N: usize, M, T, O>(
     first: u32,
     count: u32,
     mask: u64,
-    lanes: &mut Lanes<T, N>,
+    lanes: &mut PacketLanes<N>,
     obs: &mut [O],
 ) -> Option<()>
 where
@@ -73,40 +75,35 @@ where
     T: TriangleTest,
     O: Observer,
 {
-    let mut rest = mask;
-    while rest != 0 {
-        // The next eight rays of the mask, lane `k` holding ray `ray[k]`.
-        let mut r = RayLanes {
-            origin: [[0.0; 8]; 3],
-            shear: [[0.0; 8]; 3],
-            axes: [[0; 8]; 3],
-            tmin: [f32::INFINITY; 8],
-            tmax: [f32::NEG_INFINITY; 8],
-        };
-        let (mut ray, mut live) = ([0usize; 8], 0u32);
-        // Each lane's ray as given, by axis; the watertight constants are made from these for all
-        // eight lanes at once (`shear_lanes`), not ray by ray.
-        let (mut dir, mut org) = ([[1.0f32; 8]; 3], [[0.0f32; 8]; 3]);
-        for (k, slot) in ray.iter_mut().enumerate() {
-            if rest == 0 {
-                break;
-            }
-            let i = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            let Some((c, q)) = lanes.get(i).and_then(Option::as_ref) else { continue };
-            if live == 0 {
-                // `T` is the watertight test for every ray or for none: nothing is tested before
-                // the first ray's constants decide.
-                T::sheared(&c.tri())?;
-            }
-            for a in 0..3 {
-                (dir[a][k], org[a][k]) = (c.ray.dir[a], c.ray.origin[a]);
-            }
-            (r.tmin[k], r.tmax[k]) = (c.ray.tmin, q.limit());
-            *slot = i;
-            live |= 1 << k;
+    let mask = mask & lanes.traced;
+    if N % 8 != 0 {
+        return None;
+    }
+    if mask != 0 {
+        // `T` is the watertight test for every ray or for none: nothing is tested before one
+        // ray's constants decide.
+        T::sheared(&T::prepare(&lanes.ray(mask.trailing_zeros() as usize)))?;
+    }
+    for g in 0..N / 8 {
+        let mut live = ((mask >> (8 * g)) & 0xff) as u32;
+        if live == 0 {
+            continue;
         }
-        shear_lanes(&dir, &org, &mut r);
+        let at = 8 * g;
+        let ld = |a: &[f32; N]| _mm256_loadu_ps(a.as_ptr().add(at));
+        // Lanes without a ray of `mask` get a direction of (1, 1, 1): finite constants that no
+        // test reads.
+        let in_mask = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+            _mm256_and_si256(_mm256_set1_epi32(live as i32), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+            _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128),
+        ));
+        let dir = |a: usize| _mm256_blendv_ps(_mm256_set1_ps(1.0), ld(&lanes.dir[a]), in_mask);
+        let o = &lanes.rays.origin;
+        let mut r =
+            RayLanes { origin: [[0.0; 8]; 3], shear: [[0.0; 8]; 3], axes: [[0; 8]; 3], tmin: [0.0; 8], tmax: [0.0; 8] };
+        shear_lanes([dir(0), dir(1), dir(2)], [ld(&o[0]), ld(&o[1]), ld(&o[2])], &mut r);
+        _mm256_storeu_ps(r.tmin.as_mut_ptr(), ld(&lanes.tmin));
+        _mm256_storeu_ps(r.tmax.as_mut_ptr(), ld(&lanes.limit));
         for pos in first..first + count {
             if live == 0 {
                 break;
@@ -120,20 +117,23 @@ where
             while m != 0 {
                 let k = m.trailing_zeros() as usize;
                 m &= m - 1;
-                let (bit, i) = (1 << k, ray[k]);
+                let (bit, i) = (1 << k, at + k);
                 if O::ENABLED {
                     obs[i].primitive(prim);
                 }
-                let Some((c, q)) = lanes[i].as_mut() else { continue };
                 let found = if h.slow & bit != 0 {
-                    let [a, b, cv] = &*tri;
-                    T::intersect_in_place(&c.tri(), [a.as_ref(), b.as_ref(), cv.as_ref()], r.tmin[k], r.tmax[k])
+                    let [a, b, c] = &*tri;
+                    let ray = T::prepare(&lanes.ray(i));
+                    T::intersect_in_place(&ray, [a.as_ref(), b.as_ref(), c.as_ref()], r.tmin[k], r.tmax[k])
                 } else if h.hit & bit != 0 {
                     Some(TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] })
                 } else {
                     None
                 };
-                if let Some(hit) = found.filter(|hit| q.offer(*hit, prim)) {
+                let Some(hit) = found else { continue };
+                let mut q = lanes.answer(i);
+                if q.offer(hit, prim) {
+                    lanes.record(i, &q);
                     if O::ENABLED {
                         obs[i].hit(prim, hit.t);
                     }
@@ -158,10 +158,8 @@ where
 /// The processor must run the AVX2 path ([`crate::avx::available`]).
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
-unsafe fn shear_lanes(dir: &[[f32; 8]; 3], org: &[[f32; 8]; 3], r: &mut RayLanes) {
-    let ld = |a: &[f32; 8]| _mm256_loadu_ps(a.as_ptr());
+unsafe fn shear_lanes(d: [__m256; 3], o: [__m256; 3], r: &mut RayLanes) {
     let abs = |x: __m256| _mm256_andnot_ps(_mm256_set1_ps(-0.0), x);
-    let (d, o) = ([ld(&dir[0]), ld(&dir[1]), ld(&dir[2])], [ld(&org[0]), ld(&org[1]), ld(&org[2])]);
     let (ax, ay, az) = (abs(d[0]), abs(d[1]), abs(d[2]));
     // Ties go to the lower axis, as in the scalar test.
     let x_dom = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(ax, ay), _mm256_cmp_ps::<_CMP_GE_OQ>(ax, az));
@@ -301,13 +299,14 @@ mod tests {
     use crate::test_rng::Rng;
     use glam::Vec3;
     use raytrail_core::geometry::Triangle;
-    use raytrail_core::intersect::{NoPair, TriangleHit, Watertight};
+    use raytrail_core::intersect::{TriangleHit, Watertight};
     use raytrail_core::method::Query;
     use raytrail_core::observe::{NoObserver, Observer};
-    use raytrail_core::traverse::begin;
-    use raytrail_core::wide::packet::{Lanes, PacketKernel, ReferencePacketKernel};
+    use raytrail_core::traverse::begin_slab;
+    use raytrail_core::wide::packet::{PacketKernel, PacketLanes, ReferencePacketKernel};
     use raytrail_core::wide::{FastKernel, LeafBlock, WideSliceMemory};
     use raytrail_core::Ray;
+    use std::arch::x86_64::_mm256_loadu_ps;
 
     /// Each test and each accepted hit, in order.
     #[derive(Debug, Default, PartialEq)]
@@ -344,9 +343,9 @@ mod tests {
                 triangles.chunks(4).zip(prims.chunks(4)).map(|(t, p)| LeafBlock::new(t, p)).collect();
             let mem = WideSliceMemory::<8> { nodes: &[], triangles: &triangles, blocks: &blocks };
             let query = if round % 3 == 0 { Query::Any } else { Query::Closest };
-            let mut lanes: Lanes<Watertight, 32> = core::array::from_fn(|_| None);
+            let mut lanes = PacketLanes::<32>::new(query);
             let mut mask = 0u64;
-            for (i, lane) in lanes.iter_mut().enumerate() {
+            for i in 0..32 {
                 let tri = triangles[(rng.next() % count as u64) as usize];
                 // Barycentric weights in quarters: vertices, edges, insides, and points outside.
                 let mut weight = || (rng.next() % 5) as f32 / 4.0;
@@ -360,20 +359,22 @@ mod tests {
                     [0.0, 0.5][(rng.next() % 2) as usize],
                     [f32::INFINITY, 1.0][(rng.next() % 2) as usize],
                 );
-                let Some((ctx, mut q)) = begin::<Watertight, NoPair>(&ray, 8.0, query) else { continue };
+                let Some(slab) = begin_slab(&ray, 8.0) else { continue };
+                lanes.set_lane(i, &ray, &slab);
                 if query == Query::Closest && rng.next() % 4 == 0 {
+                    let mut q = lanes.answer(i);
                     q.offer(TriangleHit { t: (rng.next() % 8) as f32 / 4.0, u: 0.0, v: 0.0 }, (rng.next() % 11) as u32);
+                    lanes.record(i, &q);
                 }
-                *lane = Some((ctx, q));
                 if rng.next() % 5 != 0 {
                     mask |= 1 << i;
                 }
             }
-            let (mut want, mut got, mut quiet) = (lanes.clone(), lanes.clone(), lanes);
+            let (mut want, mut got, mut quiet) = (lanes, lanes, lanes);
             let (mut want_log, mut got_log): (Vec<Log>, Vec<Log>) =
                 ((0..32).map(|_| Log::default()).collect(), (0..32).map(|_| Log::default()).collect());
             let first = 0;
-            ReferencePacketKernel::leaf::<8, 32, _, _, FastKernel, _>(
+            ReferencePacketKernel::leaf::<8, 32, _, Watertight, FastKernel, _>(
                 &mem,
                 first,
                 count as u32,
@@ -381,7 +382,7 @@ mod tests {
                 &mut want,
                 &mut want_log,
             );
-            crate::avx_packet::AvxPacketKernel::leaf::<8, 32, _, _, AvxKernel, _>(
+            crate::avx_packet::AvxPacketKernel::leaf::<8, 32, _, Watertight, AvxKernel, _>(
                 &mem,
                 first,
                 count as u32,
@@ -390,7 +391,7 @@ mod tests {
                 &mut got_log,
             );
             let mut no_obs: Vec<NoObserver> = (0..32).map(|_| NoObserver).collect();
-            crate::avx_packet::AvxPacketKernel::leaf::<8, 32, _, _, AvxKernel, _>(
+            crate::avx_packet::AvxPacketKernel::leaf::<8, 32, _, Watertight, AvxKernel, _>(
                 &mem,
                 first,
                 count as u32,
@@ -399,8 +400,9 @@ mod tests {
                 &mut no_obs,
             );
             for i in 0..32 {
-                let answer = |l: &Lanes<Watertight, 32>| {
-                    l[i].as_ref().map(|(_, q)| (q.hit.prim, [q.hit.t, q.hit.u, q.hit.v].map(f32::to_bits)))
+                let answer = |l: &PacketLanes<32>| {
+                    let h = l.hit[i];
+                    (h.prim, [h.t, h.u, h.v].map(f32::to_bits), l.limit[i].to_bits())
                 };
                 assert_eq!(answer(&got), answer(&want), "round {round}, lane {i}: {triangles:?}");
                 assert_eq!(answer(&quiet), answer(&want), "round {round}, lane {i}, no observer");
@@ -448,8 +450,9 @@ mod tests {
                 tmin: [0.0; 8],
                 tmax: [0.0; 8],
             };
+            let ld = |v: &[[f32; 8]; 3]| v.map(|a| unsafe { _mm256_loadu_ps(a.as_ptr()) });
             // SAFETY: AVX2 checked above.
-            unsafe { shear_lanes(&dir, &org, &mut r) };
+            unsafe { shear_lanes(ld(&dir), ld(&org), &mut r) };
             for (k, ray) in rays.iter().enumerate() {
                 let Some(ray) = ray else { continue };
                 let want = Watertight::prepare(ray);

@@ -13,6 +13,8 @@ mod avx;
 #[cfg(target_arch = "x86_64")]
 mod avx_packet;
 #[cfg(target_arch = "x86_64")]
+mod avx_packet_begin;
+#[cfg(target_arch = "x86_64")]
 mod avx_packet_leaf;
 mod backend;
 mod bvh2;

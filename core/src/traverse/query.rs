@@ -20,6 +20,13 @@ impl QueryState {
         Self { hit: Hit::MISS, any: query.is_any(), tmax: ray.tmax }
     }
 
+    /// The answer so far `hit` to `query` for a ray whose interval ends at `tmax`: what
+    /// [`QueryState::new`] and the offers since made, for state kept by lane rather than by ray.
+    #[inline(always)]
+    pub fn resume(hit: Hit, tmax: f32, query: Query) -> Self {
+        Self { hit, any: query.is_any(), tmax }
+    }
+
     /// Current culling distance: the closest hit so far, or the ray's `tmax`. Inclusive, so a
     /// candidate at exactly this distance is still tested and ties resolve by primitive id.
     #[inline(always)]

@@ -24,19 +24,21 @@
 //! box it enters before its closest hit, and ties go to the smaller primitive id whatever the
 //! order. Any-hit answers agree on occlusion (which occluder is found first may differ).
 //!
-//! The box tests of a node and the leaf tests are a [`PacketKernel`]: the plain
-//! [`ReferencePacketKernel`], one ray and one child at a time and each ray alone at a leaf, or a
-//! backend's vector tests that equal it.
+//! The packet keeps its rays by lane, an array per field ([`PacketLanes`]), so that vector code
+//! makes and reads eight rays per operation; a ray that goes alone gets its context made from its
+//! lane. The rays' setup, the box tests of a node and the leaf tests are a [`PacketKernel`]: the
+//! plain [`ReferencePacketKernel`], ray by ray, one ray and one child at a time and each ray alone
+//! at a leaf, or a backend's vector code that equals it.
 
 use super::kernel::{ChildHits, ChildKernel, ReferenceKernel};
 use super::memory::WideMemory;
 use super::node::{WideChild, WideNode};
 use super::traverse::{leaf, visiting_order, WideRayContext, WideRoot, WideState, WIDE_STACK};
-use crate::intersect::{NoPair, SlabRay, TriangleTest};
+use crate::intersect::{RayContext, SlabRay, TriangleTest};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
 use crate::traverse::packets::{for_each_packet, PACKET_CHUNK};
-use crate::traverse::{begin, QueryState};
+use crate::traverse::{begin_slab, QueryState};
 use crate::{Hit, Ray};
 use core::mem::MaybeUninit;
 
@@ -79,9 +81,31 @@ pub struct PacketRays<const N: usize> {
     pub t_hi_max: f32,
 }
 
-/// Each lane's ray context and answer so far (`None` for a lane without a ray, or one that
-/// [`begin`] turned away).
-pub type Lanes<T, const N: usize> = [Option<(WideRayContext<T>, QueryState)>; N];
+/// A packet's rays by lane, as arrays by field: the box tests' view ([`PacketRays`]), the rest of
+/// each ray as given, and each ray's answer so far. A backend's vector code makes and reads eight
+/// lanes per operation; a ray that must go alone (handed over, or tested by a scalar leaf) gets
+/// its context and answer made from its lane ([`PacketLanes::context`], [`PacketLanes::answer`])
+/// and gives the answer back ([`PacketLanes::record`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PacketLanes<const N: usize> {
+    /// The box tests' view of the lanes.
+    pub rays: PacketRays<N>,
+    /// Directions, by axis.
+    pub dir: [[f32; N]; 3],
+    /// Interval starts, as given.
+    pub tmin: [f32; N],
+    /// Interval ends, as given.
+    pub tmax: [f32; N],
+    /// Each ray's culling distance ([`QueryState::limit`]): its closest hit so far, or `tmax`.
+    pub limit: [f32; N],
+    /// Each ray's answer so far ([`Hit::MISS`] until one is found).
+    pub hit: [Hit; N],
+    /// The lanes holding a ray that [`begin_slab`] accepted (the others stay as
+    /// [`PacketLanes::new`] left them and answer a miss).
+    pub traced: u64,
+    /// What every ray of the packet asks.
+    pub query: Query,
+}
 
 /// The box tests of one node for a packet: per child slot, the rays that hit it and its key.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,16 +123,29 @@ pub trait PacketKernel {
     /// of their entry distances.
     fn test<const W: usize, const N: usize>(node: &WideNode<W>, rays: &PacketRays<N>, mask: u64) -> PacketHits<W>;
 
-    /// Tests leaf `(first, count)` for the rays of `mask`, each with its context and its answer
-    /// so far in `lanes`, as each ray would alone with the single-ray leaf test of `K`: the same
-    /// answers, and each ray's events in the same order. By default each ray alone, in lane order.
+    /// Puts `rays` (at most `N`, at most 64; the rest is ignored) in the lanes of `lanes`, fresh
+    /// from [`PacketLanes::new`]: lane `i` gets ray `i` where [`begin_slab`] accepts it, as
+    /// [`PacketLanes::set_lane`] puts it, and the packet's bounds cover exactly those rays. By
+    /// default ray by ray.
+    #[inline(always)]
+    fn begin<const N: usize>(rays: &[Ray], scene_scale: f32, lanes: &mut PacketLanes<N>) {
+        for (i, ray) in rays.iter().enumerate().take(N.min(64)) {
+            if let Some(slab) = begin_slab(ray, scene_scale) {
+                lanes.set_lane(i, ray, &slab);
+            }
+        }
+    }
+
+    /// Tests leaf `(first, count)` for the rays of `mask`, each with its answer so far in
+    /// `lanes`, as each ray would alone with the single-ray leaf test of `K`: the same answers,
+    /// and each ray's events in the same order. By default each ray alone, in lane order.
     #[inline(always)]
     fn leaf<const W: usize, const N: usize, M, T, K, O>(
         mem: &M,
         first: u32,
         count: u32,
         mask: u64,
-        lanes: &mut Lanes<T, N>,
+        lanes: &mut PacketLanes<N>,
         obs: &mut [O],
     ) where
         M: WideMemory<W> + ?Sized,
@@ -116,7 +153,7 @@ pub trait PacketKernel {
         K: ChildKernel,
         O: Observer,
     {
-        each_alone(mask, lanes, obs, |c, q, o| {
+        each_alone::<T, O, N>(mask, lanes, obs, |c, q, o| {
             leaf::<W, M, T, K, O>(mem, first, count, c, q, o);
         });
     }
@@ -170,18 +207,18 @@ impl<const N: usize> PacketRays<N> {
         t_hi_max: f32::NEG_INFINITY,
     };
 
-    /// Puts the ray of `ctx`, whose answer so far is `q`, in lane `i` (below `N`), widening the
-    /// packet's bounds to it.
+    /// Puts the ray of slab constants `slab`, interval start `tmin` and culling distance `limit`
+    /// in lane `i` (below `N`), widening the packet's bounds to it.
     #[inline(always)]
-    pub fn set_lane<T: TriangleTest>(&mut self, i: usize, ctx: &WideRayContext<T>, q: &QueryState) {
+    pub fn set_lane(&mut self, i: usize, slab: &SlabRay, tmin: f32, limit: f32) {
         for a in 0..3 {
-            (self.origin[a][i], self.inv_dir[a][i]) = (ctx.slab.origin[a], ctx.slab.inv_dir[a]);
+            (self.origin[a][i], self.inv_dir[a][i]) = (slab.origin[a], slab.inv_dir[a]);
             let (o, inv) = (&mut self.origin_range[a], &mut self.inv_range[a]);
-            *o = (o.0.min(ctx.slab.origin[a]), o.1.max(ctx.slab.origin[a]));
-            *inv = (inv.0.min(ctx.slab.inv_dir[a]), inv.1.max(ctx.slab.inv_dir[a]));
+            *o = (o.0.min(slab.origin[a]), o.1.max(slab.origin[a]));
+            *inv = (inv.0.min(slab.inv_dir[a]), inv.1.max(slab.inv_dir[a]));
         }
-        (self.t_lo[i], self.t_hi[i]) = ctx.box_interval(q.limit());
-        self.slack[i] = ctx.slab.slack;
+        (self.t_lo[i], self.t_hi[i]) = slab.widen(tmin, limit);
+        self.slack[i] = slab.slack;
         self.t_lo_min = self.t_lo_min.min(self.t_lo[i]);
         self.slack_max = self.slack_max.max(self.slack[i]);
         self.t_hi_max = self.t_hi_max.max(self.t_hi[i]);
@@ -196,6 +233,72 @@ impl<const N: usize> PacketRays<N> {
             negative: [inv.x.is_sign_negative(), inv.y.is_sign_negative(), inv.z.is_sign_negative()],
             slack: self.slack[i],
         }
+    }
+}
+
+impl<const N: usize> PacketLanes<N> {
+    /// A packet without rays, for `query`.
+    #[inline(always)]
+    pub fn new(query: Query) -> Self {
+        PacketLanes {
+            rays: PacketRays::EMPTY,
+            dir: [[0.0; N]; 3],
+            tmin: [0.0; N],
+            tmax: [0.0; N],
+            limit: [0.0; N],
+            hit: [Hit::MISS; N],
+            traced: 0,
+            query,
+        }
+    }
+
+    /// Puts `ray`, whose slab constants (with their slack) are `slab`, in lane `i` (below `N` and
+    /// 64) with no answer yet.
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, ray: &Ray, slab: &SlabRay) {
+        self.rays.set_lane(i, slab, ray.tmin, ray.tmax);
+        for a in 0..3 {
+            self.dir[a][i] = ray.dir[a];
+        }
+        (self.tmin[i], self.tmax[i], self.limit[i]) = (ray.tmin, ray.tmax, ray.tmax);
+        self.traced |= 1 << i;
+    }
+
+    /// Lane `i`'s ray as given.
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        let r = &self.rays;
+        Ray {
+            origin: [r.origin[0][i], r.origin[1][i], r.origin[2][i]],
+            tmin: self.tmin[i],
+            dir: [self.dir[0][i], self.dir[1][i], self.dir[2][i]],
+            tmax: self.tmax[i],
+        }
+    }
+
+    /// Lane `i`'s ray context, as [`begin`](crate::traverse::begin) makes it (the triangle
+    /// test's constants are made on first use, afresh each time a context is made).
+    #[inline(always)]
+    pub fn context<T: TriangleTest>(&self, i: usize) -> WideRayContext<T> {
+        RayContext::from_slab(&self.ray(i), self.rays.slab(i))
+    }
+
+    /// Lane `i`'s answer so far.
+    #[inline(always)]
+    pub fn answer(&self, i: usize) -> QueryState {
+        QueryState::resume(self.hit[i], self.tmax[i], self.query)
+    }
+
+    /// Keeps `q` as lane `i`'s answer so far (and its culling distance).
+    #[inline(always)]
+    pub fn record(&mut self, i: usize, q: &QueryState) {
+        (self.hit[i], self.limit[i]) = (q.hit, q.limit());
+    }
+
+    /// Whether lane `i`'s query is answered (an any-hit ray that found a hit).
+    #[inline(always)]
+    pub fn is_answered(&self, i: usize) -> bool {
+        self.query.is_any() && self.hit[i].is_hit()
     }
 }
 
@@ -231,16 +334,9 @@ pub fn trace_wide_packet<
     obs: &mut [O],
 ) {
     let n = rays.len().min(N).min(64).min(hits.len()).min(obs.len());
-    let mut ctx: Lanes<T, N> = core::array::from_fn(|_| None);
-    let mut p = PacketRays::<N>::EMPTY;
-    let mut active = 0u64;
-    for i in 0..n {
-        hits[i] = Hit::MISS;
-        let Some((c, q)) = begin::<T, NoPair>(&rays[i], root.scene_scale, query) else { continue };
-        p.set_lane(i, &c, &q);
-        ctx[i] = Some((c, q));
-        active |= 1 << i;
-    }
+    let mut lanes = PacketLanes::<N>::new(query);
+    P::begin(&rays[..n], root.scene_scale, &mut lanes);
+    let mut active = lanes.traced;
     let mut stack: [MaybeUninit<Entry>; WIDE_STACK] = [const { MaybeUninit::uninit() }; WIDE_STACK];
     let mut len = 0usize;
     let mut current = (active != 0).then_some((root.root, active));
@@ -255,13 +351,13 @@ pub fn trace_wide_packet<
         let next = match child {
             _ if hand_over => {
                 let sub = WideRoot { root: child, ..root };
-                each_alone(mask, &mut ctx, obs, |c, q, o| single.run::<M, T, K, O>(mem, sub, c, q, o));
-                settle(mask, &ctx, &mut p, &mut active, query);
-                pop::<N, P, O>(&stack, &mut len, &p, active, obs)
+                each_alone::<T, O, N>(mask, &mut lanes, obs, |c, q, o| single.run::<M, T, K, O>(mem, sub, c, q, o));
+                settle(mask, &mut lanes, &mut active);
+                pop::<N, P, O>(&stack, &mut len, &lanes.rays, active, obs)
             }
             WideChild::Node(index) => {
                 let node = mem.wide_node(index);
-                let h = P::test::<W, N>(&node, &p, mask);
+                let h = P::test::<W, N>(&node, &lanes.rays, mask);
                 let hit_slots = (0..W).fold(0u32, |m, s| m | u32::from(h.rays[s] != 0) << s);
                 let mut order = [0u32; W];
                 let count = if hit_slots == 0 {
@@ -279,13 +375,13 @@ pub fn trace_wide_packet<
                 let first = order[0] as usize % W;
                 match node.child_ref(first).filter(|_| count > 0) {
                     Some(c) => Some((c, h.rays[first])),
-                    None => pop::<N, P, O>(&stack, &mut len, &p, active, obs),
+                    None => pop::<N, P, O>(&stack, &mut len, &lanes.rays, active, obs),
                 }
             }
             WideChild::Leaf { first, count } => {
-                P::leaf::<W, N, M, T, K, O>(mem, first, count, mask, &mut ctx, obs);
-                settle(mask, &ctx, &mut p, &mut active, query);
-                pop::<N, P, O>(&stack, &mut len, &p, active, obs)
+                P::leaf::<W, N, M, T, K, O>(mem, first, count, mask, &mut lanes, obs);
+                settle(mask, &mut lanes, &mut active);
+                pop::<N, P, O>(&stack, &mut len, &lanes.rays, active, obs)
             }
         };
         current = match next {
@@ -296,51 +392,42 @@ pub fn trace_wide_packet<
             _ => None,
         };
     }
-    for i in 0..n {
-        if let Some((_, q)) = &ctx[i] {
-            hits[i] = q.hit;
-        }
-    }
+    hits[..n].copy_from_slice(&lanes.hit[..n]);
 }
 
-/// Lets each ray of `mask`, in lane order, do `f` on its own (test a leaf, or walk a handed-over
-/// subtree) with its context, its answer so far and its observer.
+/// Lets each traced ray of `mask`, in lane order, do `f` on its own (test a leaf, or walk a
+/// handed-over subtree) with its context and answer so far made from its lane, and its observer;
+/// keeps the answer in the lane after.
 #[inline(always)]
 fn each_alone<T: TriangleTest, O: Observer, const N: usize>(
     mask: u64,
-    lanes: &mut Lanes<T, N>,
+    lanes: &mut PacketLanes<N>,
     obs: &mut [O],
     mut f: impl FnMut(&WideRayContext<T>, &mut QueryState, &mut O),
 ) {
-    for_each_ray(mask, |i| {
-        if let Some((c, q)) = lanes[i].as_mut() {
-            f(c, q, &mut obs[i]);
-        }
+    for_each_ray(mask & lanes.traced, |i| {
+        let (c, mut q) = (lanes.context::<T>(i), lanes.answer(i));
+        f(&c, &mut q, &mut obs[i]);
+        lanes.record(i, &q);
     });
 }
 
 /// After the rays of `mask` tested a leaf or walked a handed-over subtree: takes an answered ray
 /// out of the packet and narrows the others' box intervals to their closest hits.
 #[inline(always)]
-fn settle<T: TriangleTest, const N: usize>(
-    mask: u64,
-    ctx: &Lanes<T, N>,
-    p: &mut PacketRays<N>,
-    active: &mut u64,
-    query: Query,
-) {
-    for_each_ray(mask, |i| {
-        let Some((c, q)) = ctx[i].as_ref() else { return };
-        if q.is_answered() {
+fn settle<const N: usize>(mask: u64, lanes: &mut PacketLanes<N>, active: &mut u64) {
+    for_each_ray(mask & lanes.traced, |i| {
+        if lanes.is_answered(i) {
             *active &= !(1 << i);
         } else {
-            p.t_hi[i] = c.box_interval(q.limit()).1;
+            // The end of `SlabRay::widen`.
+            lanes.rays.t_hi[i] = lanes.limit[i] + lanes.rays.slack[i];
         }
     });
     // Lanes without a ray hold `-inf`, and closest-hit rays never leave the packet; an any-hit
     // ray's interval never shrinks, so the bound stays one (if looser) as its rays leave.
-    if !query.is_any() {
-        p.t_hi_max = p.t_hi.iter().fold(f32::NEG_INFINITY, |m, &t| m.max(t));
+    if !lanes.query.is_any() {
+        lanes.rays.t_hi_max = lanes.rays.t_hi.iter().fold(f32::NEG_INFINITY, |m, &t| m.max(t));
     }
 }
 
