@@ -226,52 +226,60 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
 ) -> Option<WideChild> {
     let node = mem.wide_node(index);
     let n = s.live.len();
-    s.masks.resize(n, 0);
-    s.t_enter.resize(n, [f32::INFINITY; W]);
+    // Grown only, never refilled: the box tests write every entry they read back.
+    if s.masks.len() < n {
+        s.masks.resize(n, 0);
+        s.t_enter.resize(n, [f32::INFINITY; W]);
+    }
+    let (masks, t_enter) = (&mut s.masks[..n], &mut s.t_enter[..n]);
     let (mut counts, mut keys) = ([0u32; W], [f32::INFINITY; W]);
-    K::stream_node::<W>(&node, &s.live, &s.rays, &mut s.masks, &mut s.t_enter, &mut keys, &mut counts);
+    K::stream_node::<W>(&node, &s.live, &s.rays, masks, t_enter, &mut keys, &mut counts);
     let hit_slots = (0..W).fold(0u32, |m, c| m | u32::from(counts[c] > 0) << c);
     if hit_slots == 0 {
         return None;
     }
     let mut order = [0u32; W];
     let count = visiting_order::<W, K>(&ChildHits { t_enter: keys, mask: hit_slots }, query.is_any(), &mut order);
-    // A list per hit child, in visiting order from the farthest, so that the first child's lies
-    // on top and the nearest pushed one's under it; each padded by one entry, so that every ray
-    // writes to the list and moves on only where it hit (a write without a branch).
+    // A list per pushed child, in visiting order from the farthest, so that the nearest pushed
+    // one's lies on top; each padded by one entry, so that every ray writes to the list and moves
+    // on only where it hit (a write without a branch).
     let spare = s.items.len();
     let mut at = [spare; W];
-    let mut start = [spare; W];
     let mut end = spare + 1;
-    for k in (0..count).rev() {
+    for k in (1..count).rev() {
         let slot = order[k] as usize % W;
-        (at[slot], start[slot]) = (end, end);
+        at[slot] = end;
         end += counts[slot] as usize + 1;
-        if k > 0 && s.stack.len() < WIDE_STACK {
+        if s.stack.len() < WIDE_STACK {
             if let Some(c) = node.child_ref(slot) {
                 s.stack.push(Entry { child: c, start: end - counts[slot] as usize - 1, len: counts[slot] as usize });
             }
         }
     }
     s.items.resize(end, 0);
-    // One pass over the rays per hit child: the write position stays in a register.
-    for &slot in &order[..count] {
+    // One pass over the rays per pushed child: the write position stays in a register.
+    for &slot in &order[1..count] {
         let c = slot as usize % W;
         let mut to = at[c];
-        for ((&r, &m), t_enter) in s.live.iter().zip(&s.masks).zip(&s.t_enter) {
+        for ((&r, &m), t_enter) in s.live.iter().zip(&*masks).zip(&*t_enter) {
             // SAFETY: `to` stays within `items`: the child's list has one entry to spare beyond
             // its count of rays, and only a ray that hit it moves `to` on.
             unsafe { *s.items.get_unchecked_mut(to) = item(r, t_enter[c]) };
             to += ((m >> c) & 1) as usize;
         }
-        at[c] = to;
     }
+    // The last list's pad (or the spare entry) leaves the buffer.
+    s.items.truncate(end - 1);
     // The first child's rays visit it with no test of their entry distance (a ray goes straight
-    // on to its nearest child, as it would alone), and its list leaves the buffer.
+    // on to its nearest child, as it would alone): they stay in `live`, in order, compacted in
+    // place (a ray is never written past where it is read) without a branch.
     let first = order[0] as usize % W;
-    s.live.clear();
-    s.live.extend(s.items[start[first]..at[first]].iter().map(|&it| unpack(it).0 as u32));
-    s.items.truncate(start[first] - 1);
+    let mut to = 0;
+    for (k, &m) in masks.iter().enumerate() {
+        s.live[to] = s.live[k];
+        to += ((m >> first) & 1) as usize;
+    }
+    s.live.truncate(to);
     node.child_ref(first)
 }
 
