@@ -50,7 +50,8 @@ pub(crate) unsafe fn begin<const N: usize>(rays: &[Ray], scene_scale: f32, lanes
     };
     for g in 0..n.div_ceil(8) {
         let at = 8 * g;
-        // A row past the last ray is all zeros: a zero direction, which no lane accepts.
+        // A row is one `Ray` (`repr(C)`: origin, tmin, direction, tmax); a row past the last ray
+        // is all zeros: a zero direction, which no lane accepts.
         let row = |k: usize| if at + k < n { _mm256_loadu_ps(rays.as_ptr().add(at + k).cast::<f32>()) } else { zero };
         let [ox, oy, oz, tmin, dx, dy, dz, tmax] =
             transpose([row(0), row(1), row(2), row(3), row(4), row(5), row(6), row(7)]);
