@@ -21,7 +21,6 @@ use raytrail_core::wide::packet::{
 use raytrail_core::wide::traverse::WideRoot;
 use raytrail_core::wide::{ChildKernel, WideMemory, WideNode, EMPTY_CHILD};
 use raytrail_core::{Hit, Ray};
-
 use std::arch::x86_64::{
     __m256, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps256_ps128,
     _mm256_castps_si256, _mm256_castsi256_ps, _mm256_castsi256_si128, _mm256_cmp_ps, _mm256_cmpeq_epi32,
@@ -120,8 +119,6 @@ unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &Packe
         return test_by_ray(node, p, mask);
     }
     let mut out = PacketHits { key: [f32::INFINITY; W], rays: [0; W] };
-    // Bit k of a lane's own constant: the lanes of a register group picked by 8 bits of `mask`.
-    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
     let ld = |a: &[f32; N], at: usize| _mm256_loadu_ps(a.as_ptr().add(at));
     while todo != 0 {
         let c = todo.trailing_zeros() as usize;
@@ -140,9 +137,7 @@ unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &Packe
                 (t_enter, t_exit) = slab_axis(lo, hi, ld(&p.origin[a], at), ld(&p.inv_dir[a], at), t_enter, t_exit);
             }
             let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, _mm256_add_ps(t_exit, ld(&p.slack, at)));
-            let in_mask =
-                _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(group), bits), bits));
-            let hit = _mm256_and_ps(hit, in_mask);
+            let hit = _mm256_and_ps(hit, lanes_of(group as u32));
             rays |= (_mm256_movemask_ps(hit) as u64) << at;
             key = _mm256_min_ps(_mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t_enter, hit), key);
         }
@@ -216,6 +211,19 @@ unsafe fn slab_axis(
     let tn = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
     let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), _mm256_set1_ps(FAR_PAD));
     (_mm256_max_ps(tn, t_enter), _mm256_min_ps(tf, t_exit))
+}
+
+/// The lanes picked by the low 8 bits of `group` (bit `k`: lane `k`), as an all-ones mask per
+/// picked lane.
+///
+/// # Safety
+/// The processor must support AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) unsafe fn lanes_of(group: u32) -> __m256 {
+    // Bit k of a lane's own constant.
+    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(group as i32), bits), bits))
 }
 
 /// Which way [`horizontal`] folds.

@@ -24,11 +24,11 @@ use raytrail_core::observe::Observer;
 use raytrail_core::wide::packet::PacketLanes;
 use raytrail_core::wide::WideMemory;
 use std::arch::x86_64::{
-    __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps,
-    _mm256_blendv_ps, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_div_ps,
-    _mm256_loadu_ps, _mm256_loadu_si256, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_permutevar8x32_ps,
-    _mm256_set1_epi32, _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_ps, _mm256_storeu_ps, _mm256_storeu_si256,
-    _mm256_sub_ps, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ, _CMP_NGT_UQ, _CMP_NLT_UQ,
+    __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps, _mm256_blendv_ps,
+    _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_div_ps, _mm256_loadu_ps, _mm256_loadu_si256,
+    _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_permutevar8x32_ps, _mm256_set1_epi32, _mm256_set1_ps,
+    _mm256_setzero_ps, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_ps, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ,
+    _CMP_LT_OQ, _CMP_NEQ_UQ, _CMP_NGT_UQ, _CMP_NLT_UQ,
 };
 
 /// Eight rays' watertight constants by lane.
@@ -93,10 +93,7 @@ where
         let ld = |a: &[f32; N]| _mm256_loadu_ps(a.as_ptr().add(at));
         // Lanes without a ray of `mask` get a direction of (1, 1, 1): finite constants that no
         // test reads.
-        let in_mask = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-            _mm256_and_si256(_mm256_set1_epi32(live as i32), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-            _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128),
-        ));
+        let in_mask = crate::avx_packet::lanes_of(live);
         let dir = |a: usize| _mm256_blendv_ps(_mm256_set1_ps(1.0), ld(&lanes.dir[a]), in_mask);
         let o = &lanes.rays.origin;
         let mut r =
