@@ -1,5 +1,6 @@
 //! Prefetching the hit children of wide nodes: a hint that changes no answer and no event, taken
-//! only for incoherent rays over trees larger than the caches (any-hit rays only in packets).
+//! only for incoherent rays over trees larger than the caches (any-hit rays only in packets and
+//! streams).
 
 use glam::Vec3;
 use raytrail_core::bvh2::NodeRef;
@@ -7,6 +8,7 @@ use raytrail_core::intersect::Watertight;
 use raytrail_core::method::{Collapse, Query};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
+use raytrail_core::wide::ray_stream::trace_wide_streams;
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail_core::wide::{
     worth_prefetching, FastKernel, PrefetchingMemory, ReferenceKernel, WideBvh, WideMemory, PREFETCH_ABOVE_BYTES,
@@ -65,48 +67,68 @@ fn prefetching_changes_no_answer_and_no_event() {
 /// Hits (as bits) and each ray's counters and nodes.
 type Traced = (Vec<(u32, u32, u32, u32)>, Vec<(Counters, Vec<NodeRef>)>);
 
-/// `rays` traced in packets over `mem`.
-fn in_packets<const W: usize, M: WideMemory<W>>(mem: &M, root: WideRoot, rays: &[Ray], query: Query) -> Traced {
+/// How rays share walks: in packets, or in streams.
+#[derive(Clone, Copy, Debug)]
+enum Shared {
+    Packets,
+    Streams,
+}
+
+/// `rays` traced together (`how`) over `mem`.
+fn together<const W: usize, M: WideMemory<W>>(
+    how: Shared,
+    mem: &M,
+    root: WideRoot,
+    rays: &[Ray],
+    query: Query,
+) -> Traced {
     let mut hits = vec![Hit::MISS; rays.len()];
     let mut events = vec![(Counters::default(), Vec::new()); rays.len()];
     let done = |i: usize, o: Both<Counters, Recorder>| events[i] = (o.0, o.1.nodes);
-    trace_wide_packets::<W, _, Watertight, FastKernel, ReferencePacketKernel, _>(
-        mem, root, rays, &mut hits, query, done,
-    );
+    match how {
+        Shared::Packets => trace_wide_packets::<W, _, Watertight, FastKernel, ReferencePacketKernel, _>(
+            mem, root, rays, &mut hits, query, done,
+        ),
+        Shared::Streams => {
+            trace_wide_streams::<W, _, Watertight, FastKernel, _>(mem, root, rays, &mut hits, query, done)
+        }
+    }
     (hits.iter().map(|h| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits())).collect(), events)
 }
 
-/// Packets (whose handed-over subtrees prefetch) on prefetching memory: the same answers and
-/// each ray's events as on plain memory.
-fn packets_same_as_plain<const W: usize>(wide: &WideBvh<W>, scale: f32) -> u64 {
+/// Packets (whose handed-over subtrees prefetch) or streams (whose nodes prefetch their hit
+/// children) on prefetching memory: the same answers and each ray's events as on plain memory.
+fn together_same_as_plain<const W: usize>(how: Shared, wide: &WideBvh<W>, scale: f32) -> u64 {
     let root = WideRoot { root: wide.root(), scene_scale: scale, max_steps: u32::MAX };
     let rays = scattered(1000, 11 + W as u64);
     let mut visited = 0;
     for query in [Query::Closest, Query::Any] {
-        let plain = in_packets(&wide.memory(), root, &rays, query);
-        let fetched = in_packets(&PrefetchingMemory(wide.memory()), root, &rays, query);
-        assert_eq!(fetched, plain, "{query:?}");
+        let plain = together(how, &wide.memory(), root, &rays, query);
+        let fetched = together(how, &PrefetchingMemory(wide.memory()), root, &rays, query);
+        assert_eq!(fetched, plain, "{how:?} {query:?}");
         visited += plain.1.iter().map(|e| e.0.internal_nodes).sum::<u64>();
     }
     visited
 }
 
 #[test]
-fn prefetching_changes_no_packet_answer_and_no_event() {
+fn prefetching_changes_no_packet_or_stream_answer_and_no_event() {
     let (scale, w4, w8) = wide_soup(3000, 17, Collapse::Optimal);
-    let visited = packets_same_as_plain::<4>(&w4, scale) + packets_same_as_plain::<8>(&w8, scale);
-    assert!(visited > 10_000, "only {visited} internal nodes visited");
+    for how in [Shared::Packets, Shared::Streams] {
+        let visited = together_same_as_plain::<4>(how, &w4, scale) + together_same_as_plain::<8>(how, &w8, scale);
+        assert!(visited > 10_000, "{how:?}: only {visited} internal nodes visited");
+    }
 }
 
 #[test]
-fn only_incoherent_rays_over_large_trees_prefetch_and_any_hit_ones_only_in_packets() {
+fn only_incoherent_rays_over_large_trees_prefetch_and_any_hit_ones_only_in_shared_walks() {
     let large = PREFETCH_ABOVE_BYTES + 1;
     let (scattered, camera) = (scattered(256, 5), camera(256));
     assert!(worth_prefetching(large, &scattered, Query::Closest, false));
     assert!(!worth_prefetching(PREFETCH_ABOVE_BYTES, &scattered, Query::Closest, false), "a tree that fits the caches");
     assert!(!worth_prefetching(large, &scattered, Query::Any, false), "any-hit rays alone");
-    assert!(worth_prefetching(large, &scattered, Query::Any, true), "any-hit rays in packets");
-    assert!(worth_prefetching(large, &scattered, Query::Closest, true), "closest-hit rays in packets");
+    assert!(worth_prefetching(large, &scattered, Query::Any, true), "any-hit rays in packets or streams");
+    assert!(worth_prefetching(large, &scattered, Query::Closest, true), "closest-hit rays in packets or streams");
     assert!(!worth_prefetching(large, &camera, Query::Any, true), "coherent rays in packets");
     assert!(!worth_prefetching(PREFETCH_ABOVE_BYTES, &scattered, Query::Any, true), "a small tree, in packets");
     assert!(!worth_prefetching(large, &camera, Query::Closest, false), "coherent camera rays");

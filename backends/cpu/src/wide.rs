@@ -2,8 +2,8 @@
 //! recording, with the fast child kernel (SIMD box tests, the sorting network), in the AVX2 loop
 //! where the processor has AVX2; the packet method's loop over the chunk's packets and the stream
 //! method's over its streams likewise. The memory prefetches hit children where that pays (a large
-//! tree, incoherent rays, any-hit ones only in packets: [`worth_prefetching`]; in the packet loop,
-//! only the subtrees handed over to single rays prefetch).
+//! tree, incoherent rays, any-hit ones only in packets and streams: [`worth_prefetching`]; in the
+//! packet loop, only the subtrees handed over to single rays prefetch).
 
 use crate::chunk::Chunk;
 use core::marker::PhantomData;
@@ -48,7 +48,7 @@ impl WideRun<'_> {
     /// Prefetches hit children where that pays ([`worth_prefetching`]).
     fn go<const W: usize>(&self, mem: WideSliceMemory<'_, W>, chunk: Chunk<'_>) -> Result<Counters, Error> {
         let bytes = core::mem::size_of_val(mem.nodes) + core::mem::size_of_val(mem.blocks);
-        if worth_prefetching(bytes, chunk.rays, self.opts.query, self.method.packets()) {
+        if worth_prefetching(bytes, chunk.rays, self.opts.query, self.method.shares_walks()) {
             self.test(&PrefetchingMemory(mem), chunk)
         } else {
             self.test(&mem, chunk)

@@ -25,20 +25,23 @@ pub const PREFETCH_ABOVE_BYTES: usize = 16 << 20;
 
 /// Whether a batch of `rays` answering `query` over a tree of `tree_bytes` (nodes and triangle
 /// blocks) is traced faster with [`PrefetchingMemory`]: incoherent rays over a tree larger than
-/// [`PREFETCH_ABOVE_BYTES`], closest-hit rays whether walked alone or in packets (`packets`: a
-/// packet method's, whose rays prefetch in the subtrees handed over to them), any-hit rays only in
-/// packets.
+/// [`PREFETCH_ABOVE_BYTES`], closest-hit rays whether walked alone or together, any-hit rays only
+/// together (`shared`: a method whose rays share walks, a packet method's, whose rays prefetch in
+/// the subtrees handed over to them, or a stream method's, whose streams prefetch a node's hit
+/// children for all the rays that hit them).
 ///
 /// - Any-hit rays stop at their first occluder, often before the children fetched for them are
 ///   visited. Alone, on the dragon, ambient-occlusion rays gained 2-8% from outside but lost up to
 ///   6% from inside, so they go without. In packets they gained 7-15% from outside and moved by
-///   0.94-1.00 from inside (BENCHMARKS.md, "Prefetching in the packets' handed-over subtrees").
+///   0.94-1.00 from inside (BENCHMARKS.md, "Prefetching in the packets' handed-over subtrees"); in
+///   streams 1.01-1.03 from outside and 1.00-1.02 from inside (BENCHMARKS.md, "Streams that
+///   prefetch").
 /// - Coherence is judged on up to 32 pairs of neighbouring rays spread over the batch: where at
 ///   least a quarter of them point within about 18 degrees of each other (as neighbouring camera
 ///   rays do), the previous ray will have brought the nodes in. Two directions drawn at random over
 ///   a hemisphere pass that test about one time in twenty.
-pub fn worth_prefetching(tree_bytes: usize, rays: &[Ray], query: Query, packets: bool) -> bool {
-    if (query != Query::Closest && !packets) || tree_bytes <= PREFETCH_ABOVE_BYTES || rays.len() < 2 {
+pub fn worth_prefetching(tree_bytes: usize, rays: &[Ray], query: Query, shared: bool) -> bool {
+    if (query != Query::Closest && !shared) || tree_bytes <= PREFETCH_ABOVE_BYTES || rays.len() < 2 {
         return false;
     }
     let pairs = (rays.len() - 1).min(32);
