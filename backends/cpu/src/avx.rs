@@ -35,6 +35,17 @@ pub(crate) fn available() -> bool {
         && std::arch::is_x86_feature_detected!("popcnt")
 }
 
+/// For a test of an AVX2 path: whether this processor lacks AVX2, in which case the test is said
+/// to be skipped (`what`: the test's name in the message) and should return.
+#[cfg(test)]
+pub(crate) fn lacks_avx2_for(what: &str) -> bool {
+    let lacks = !available();
+    if lacks {
+        eprintln!("SKIPPED the AVX2 {what} test: this processor has no AVX2");
+    }
+    lacks
+}
+
 /// The fast kernel with 8-wide nodes tested in one AVX operation per plane and ordered by
 /// [`order_by_rank`] where three or more children are hit. Private to this
 /// module and used only inside [`trace_batch`], whose caller has checked for AVX2: that is what
@@ -297,8 +308,7 @@ mod tests {
 
     #[test]
     fn avx_kernel_matches_the_reference_bit_for_bit_on_adversarial_values() {
-        if !available() {
-            eprintln!("SKIPPED the AVX2 kernel test: this processor has no AVX2");
+        if lacks_avx2_for("kernel") {
             return;
         }
         let mut v = Values(0x9e37_79b9_7f4a_7c15);
@@ -340,8 +350,7 @@ mod tests {
     /// every count of hit children from three to eight.
     #[test]
     fn rank_order_matches_the_reference_on_ties() {
-        if !available() {
-            eprintln!("SKIPPED the AVX2 order test: this processor has no AVX2");
+        if lacks_avx2_for("order") {
             return;
         }
         let keys = [0.0, -0.0, 1.0, 1.0, 0.5, 0.0, 1.0, -0.0];

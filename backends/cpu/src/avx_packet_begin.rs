@@ -196,8 +196,7 @@ mod tests {
     /// 32 rays with zero, infinite and NaN components, reversed intervals and unreliable slacks.
     #[test]
     fn lanes_made_eight_at_once_are_each_rays_own() {
-        if !crate::avx::available() {
-            eprintln!("SKIPPED the AVX2 packet begin test: this processor has no AVX2");
+        if crate::avx::lacks_avx2_for("packet begin") {
             return;
         }
         let mut rng = Rng(0x6a09_e667_f3bc_c909);

@@ -324,8 +324,7 @@ mod tests {
     /// leaf's, with and without an observer.
     #[test]
     fn rays_in_lanes_match_the_single_ray_leaf() {
-        if !crate::avx::available() {
-            eprintln!("SKIPPED the AVX2 packet leaf test: this processor has no AVX2");
+        if crate::avx::lacks_avx2_for("packet leaf") {
             return;
         }
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
@@ -419,8 +418,7 @@ mod tests {
     /// every sign: the axis order, the origin in that order and the shear.
     #[test]
     fn lane_constants_are_each_rays_own() {
-        if !crate::avx::available() {
-            eprintln!("SKIPPED the AVX2 lane constants test: this processor has no AVX2");
+        if crate::avx::lacks_avx2_for("lane constants") {
             return;
         }
         use raytrail_core::intersect::TriangleTest;

@@ -16,14 +16,26 @@ pub trait WideMemory<const W: usize> {
     fn wide_triangle(&self, pos: u32) -> MemRead<'_, [Vec3; 3]>;
     /// The block of four triangles `index` (positions `4 index ..`).
     fn wide_block(&self, index: u32) -> MemRead<'_, TriangleBlock>;
-    /// Whether [`WideMemory::prefetch_child`] does anything. The traversal skips its loop over
-    /// the hit slots where it does not: the compiler keeps an empty loop over mask bits, whose
+    /// Whether [`WideMemory::prefetch_child`] does anything. [`WideMemory::prefetch_hit_children`]
+    /// skips its loop over the hit slots where it does not: the compiler keeps an empty loop over mask bits, whose
     /// exit branch depends on the number of children hit.
     const PREFETCHES: bool = false;
     /// A hint, right after `node`'s box test, that its hit child `slot` will be visited: memory
     /// that can bring it closer starts loading it. By default nothing happens.
     #[inline(always)]
     fn prefetch_child(&self, _node: &WideNode<W>, _slot: usize) {}
+    /// [`WideMemory::prefetch_child`] for every slot of `mask` (a bit per hit child), or nothing
+    /// at all, not even the loop over the bits, where the memory does not prefetch.
+    #[inline(always)]
+    fn prefetch_hit_children(&self, node: &WideNode<W>, mask: u32) {
+        if Self::PREFETCHES {
+            let mut m = mask;
+            while m != 0 {
+                self.prefetch_child(node, m.trailing_zeros() as usize);
+                m &= m - 1;
+            }
+        }
+    }
 }
 
 /// A wide tree in plain slices: the CPU backend's memory.

@@ -245,13 +245,7 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
     }
     // As early as the hit children are known, so that their loads overlap the ordering and the
     // lists below (the single-ray walk's prefetch; the memory decides whether it does anything).
-    if M::PREFETCHES {
-        let mut m = hit_slots;
-        while m != 0 {
-            mem.prefetch_child(&node, m.trailing_zeros() as usize);
-            m &= m - 1;
-        }
-    }
+    mem.prefetch_hit_children(&node, hit_slots);
     let mut order = [0u32; W];
     let count = visiting_order::<W, K>(&ChildHits { t_enter: keys, mask: hit_slots }, query.is_any(), &mut order);
     // A list per pushed child, in visiting order from the farthest, so that the nearest pushed

@@ -180,13 +180,7 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
         return Expanded::NoneHit;
     }
     // As early as the hit children are known, so that their loads overlap the ordering below.
-    if M::PREFETCHES {
-        let mut m = hits.mask;
-        while m != 0 {
-            mem.prefetch_child(&node, m.trailing_zeros() as usize);
-            m &= m - 1;
-        }
-    }
+    mem.prefetch_hit_children(&node, hits.mask);
     let mut order = [0u32; W];
     let n = visiting_order::<W, K>(&hits, q.any, &mut order);
     for k in (1..n).rev() {
