@@ -5,14 +5,14 @@
 //! one run. Scenes come from `../shared/scenes` (or `RAYTRAIL_SCENES`).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use raytrail::conformance::paths::load_mesh_scene;
-use raytrail::conformance::rays::{diffuse, primary, RAY_SEED};
 use raytrail::core::method::{Bvh2Method, KdMethod, Method};
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::{Trace, TraceOptions};
 use raytrail::core::Hit;
 use raytrail::cpu::CpuBackend;
 use raytrail::Builder;
+use raytrail_conformance::paths::load_mesh_scene;
+use raytrail_conformance::rays::{diffuse, primary, RAY_SEED};
 use std::sync::Arc;
 
 const SCENES: &[&str] = &["bunny.obj", "sponza.obj"];

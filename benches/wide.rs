@@ -15,8 +15,6 @@
 //! come from `../shared/scenes` (or `RAYTRAIL_SCENES`).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput};
-use raytrail::conformance::paths::load_mesh_scene;
-use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
 use raytrail::core::bvh2::traverse::trace_batch;
 use raytrail::core::intersect::{SlabRay, Watertight};
 use raytrail::core::key::KeyWidth;
@@ -28,6 +26,8 @@ use raytrail::core::wide::traverse::{trace_wide_batch, WideRoot};
 use raytrail::core::wide::{ChildHits, ChildKernel, FastKernel, WideNode, WideSliceMemory, WideTree};
 use raytrail::core::{Hit, Ray};
 use raytrail::Builder;
+use raytrail_conformance::paths::load_mesh_scene;
+use raytrail_conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
 use std::time::Duration;
 
 const SCENES: &[&str] = &["bunny.obj", "sponza.obj"];

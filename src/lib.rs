@@ -1,82 +1,111 @@
-//! raytrail: ray-traversal methods for triangle scenes, checked against each other.
+//! raytrail: ray-traversal methods for triangle scenes, implemented from their papers and checked
+//! against each other.
 //!
-//! Load a mesh, build its tree, prepare it for the methods you will use, and trace:
+//! # Tracing in three lines
 //!
 //! ```
-//! use raytrail::prelude::*;
-//!
-//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! // A mesh (here a triangle as OBJ text; `load_scene("file.obj")` reads a file).
-//! let mesh = raytrail::core::mesh::load_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "tri.obj")?;
-//! let scene = mesh.to_scene()?;
-//! // The canonical tree, and what the chosen method needs of it (here, the perfect hash).
-//! let bvh = Builder::Sah.build(&scene)?;
-//! let method = Method::Bvh2(Bvh2Method::Hash);
-//! let prepared = Arc::new(PreparedScene::new(&scene, bvh, &[method])?);
-//! // A backend prepares the scene once and traces batches of rays.
-//! let backend = CpuBackend::new();
-//! let cpu_scene = backend.prepare(prepared)?;
-//! let rays = [Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0), 0.0, f32::INFINITY)];
-//! let mut hits = [Hit::MISS];
-//! backend.trace(&cpu_scene, &rays, &TraceOptions::new(method), &mut hits)?;
-//! assert_eq!(hits[0].prim, 0);
-//! assert_eq!(hits[0].t, 1.0);
+//! use raytrail::{Ray, Tracer, Vec3};
+//! # fn main() -> Result<(), raytrail::Error> {
+//! let tracer = Tracer::new(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]])?;
+//! let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0), 0.0, f32::INFINITY);
+//! let hit = tracer.intersect_one(&ray)?.expect("the ray meets the triangle");
+//! assert_eq!((hit.prim, hit.t), (0, 1.0));
 //! # Ok(())
 //! # }
 //! ```
 //!
-//! The crates behind it:
-//! - [`core`]: the `no_std` core (types, tests, keys, layouts, perfect hashing, state machines);
-//! - [`cpu`]: the rayon backend and the obvhs (PLOC) builder;
-//! - [`gpu`]: the wgpu backend (WGSL kernels mirroring the core's state machines);
-//! - [`conformance`]: the scenes, ray sets, checks and the suite every backend runs.
+//! [`Tracer`] takes triangles from memory (or a loaded mesh: [`load`]), builds the best tree
+//! and traces batches ([`Tracer::intersect`], [`Tracer::occluded`], and `_into` forms that fill a
+//! caller's slice) on all cores, picking for each large batch the fastest walk of its 8-wide tree.
 //!
-//! The command line (`raytrail`, the bench and NumPy files) is the `raytrail-cli` package, so this
-//! library pulls in no bench dependency. docs/ARCHITECTURE.md tells how the parts fit.
+//! # Which method
+//!
+//! The default suits most users. To name one ([`TracerBuilder::method`], or `--method` on the
+//! command line), by the rays traced:
+//!
+//! | rays | method |
+//! |---|---|
+//! | camera rays, shadow rays toward one light (coherent) | `bvh8-sah-packet`, or `kd-stack` for camera rays in rooms |
+//! | bounces of a path tracer, ambient occlusion (incoherent) | `bvh8-sah-stream` in large batches, `bvh8-sah` otherwise |
+//! | one ray at a time, or a few | `bvh8-sah` (any hit: `bvh8`) |
+//! | no stack memory (GPUs, hardware) | `bvh4-hash`, `hash` (Binder & Keller 2016) |
+//!
+//! Every method's page ([`core::method`]) names its paper and when to pick it.
+//!
+//! # The expert path, one level down
+//!
+//! A [`Builder`] makes the canonical tree, [`PreparedScene::new`](core::prepared::PreparedScene::new)
+//! derives what the chosen methods read (and rejects a tree built for other triangles), and a
+//! backend ([`cpu::CpuBackend`], or `gpu::WgpuBackend` with the `gpu` feature) traces batches
+//! through the backend-agnostic [`Trace`](core::trace::Trace) trait:
+//!
+//! ```
+//! use raytrail::prelude::*;
+//! # fn main() -> Result<(), raytrail::Error> {
+//! let scene = raytrail::core::scene::Scene::from_indexed(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]])?;
+//! let method = Method::Wide(WideMethod::Bvh8);
+//! let prepared = PreparedScene::new(&scene, Builder::Sah.build(&scene)?, &[method])?;
+//! let backend = CpuBackend::new();
+//! let cpu_scene = backend.prepare(Arc::new(prepared))?;
+//! let rays = [Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0), 0.0, f32::INFINITY)];
+//! let mut hits = [Hit::MISS];
+//! let report = backend.trace(&cpu_scene, &rays, &TraceOptions::new(method), &mut hits)?;
+//! assert_eq!((hits[0].prim, report.untraceable), (0, 0));
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! # Features
+//!
+//! | feature | default | adds |
+//! |---|---|---|
+//! | `cpu` | yes | the rayon backend ([`cpu`]), [`Tracer`], `auto`'s method choice ([`analysis`]) |
+//! | `loaders` | yes | mesh files ([`mesh`], [`load`]): OBJ, PLY, OFF, STL, glTF, gzip |
+//! | `gpu` | no | the wgpu backend (`gpu`): every method as a WGSL kernel; builds wgpu |
+//!
+//! A CPU-only user who passes triangles from memory depends on
+//! `raytrail = { version = "0.1", default-features = false, features = ["cpu"] }`.
+//!
+//! The crates behind it: [`core`] (the `no_std` core: types, tests, keys, layouts, perfect
+//! hashing, state machines), [`build`] (the tree builders), `cpu`, `gpu` and `mesh`. The command
+//! line is the `raytrail-cli` package and the conformance suite `raytrail-conformance`;
+//! docs/ARCHITECTURE.md tells how the parts fit.
 #![warn(missing_docs)]
 
+#[cfg(feature = "cpu")]
 pub mod analysis;
-mod builder;
+mod error;
 pub mod prelude;
+#[cfg(feature = "cpu")]
+mod tracer;
 
-pub use raytrail_conformance as conformance;
+pub use error::Error;
+#[cfg(feature = "cpu")]
+pub use tracer::{Tracer, TracerBuilder, AUTO_MIN_RAYS, AUTO_WALKS};
+
+#[doc(inline)]
+pub use raytrail_build as build;
+#[doc(inline)]
 pub use raytrail_core as core;
+#[cfg(feature = "cpu")]
+#[doc(inline)]
 pub use raytrail_cpu as cpu;
+#[cfg(feature = "loaders")]
+#[doc(inline)]
+pub use raytrail_mesh as mesh;
+#[cfg(feature = "gpu")]
+#[doc(inline)]
 pub use raytrail_wgpu as gpu;
 
-pub use builder::Builder;
+pub use raytrail_build::Builder;
+pub use raytrail_core::glam::Vec3;
+pub use raytrail_core::method::{Method, Query};
+pub use raytrail_core::{Hit, Ray};
 
-use raytrail_conformance::NamedScene;
-use raytrail_core::mesh::{LoadOptions, LoadReport};
-use std::path::Path;
-
-/// Name of the built-in scene.
-pub const BUILTIN_SCENE: &str = "builtin";
-
-/// Loads a mesh file, or the built-in generated scene for [`BUILTIN_SCENE`], with the default
-/// loading policy (elements that are not triangles or polygons skipped; see
-/// [`raytrail_core::mesh`]).
-pub fn load_scene(path: &str) -> Result<NamedScene, String> {
-    load_scene_with(path, &LoadOptions::default()).map(|(scene, _)| scene)
-}
-
-/// Loads a mesh file, or the built-in generated scene for [`BUILTIN_SCENE`], with the given
-/// loading policy; also returns what loading skipped and, with [`LoadOptions::sources`], where
-/// each triangle came from (the built-in scene's report is empty).
-pub fn load_scene_with(path: &str, options: &LoadOptions) -> Result<(NamedScene, LoadReport), String> {
-    if path == BUILTIN_SCENE {
-        return raytrail_conformance::generated()
-            .into_iter()
-            .find(|s| s.name == "sphereflake")
-            .map(|s| (s, LoadReport::default()))
-            .ok_or_else(|| "the built-in sphereflake scene is missing".to_string());
-    }
-    let (mesh, report) = raytrail_core::mesh::load_with(Path::new(path), options).map_err(|e| e.to_string())?;
-    let scene = mesh.to_scene().map_err(|e| match report.skipped {
-        0 => format!("{path}: {e}"),
-        1 => format!("{path}: {e} (1 element that is not a triangle or polygon was skipped)"),
-        n => format!("{path}: {e} ({n} elements that are not triangles or polygons were skipped)"),
-    })?;
-    let name = Path::new(path).file_name().map_or(path.to_string(), |n| n.to_string_lossy().into_owned());
-    Ok((NamedScene::new(name, scene), report))
+/// Loads a mesh file (`.obj`, `.ply`, `.off`, `.stl`, `.gltf`, `.glb`, any of them gzipped) with
+/// the default policy: elements that are not triangles or polygons are skipped
+/// ([`mesh::load_with`] counts them and can make them an error).
+#[cfg(feature = "loaders")]
+pub fn load(path: impl AsRef<std::path::Path>) -> Result<raytrail_core::scene::Mesh, Error> {
+    Ok(raytrail_mesh::load(path.as_ref())?)
 }

@@ -6,11 +6,15 @@
 
 use clap::builder::PossibleValuesParser;
 use clap::{Parser, Subcommand};
-use raytrail::conformance::NamedScene;
-use raytrail::core::mesh::{write_sources_csv, LoadOptions, LoadReport};
 use raytrail::core::method::Method;
-use raytrail::{Builder, BUILTIN_SCENE};
+use raytrail::mesh::{write_sources_csv, LoadOptions, LoadReport};
+use raytrail::Builder;
+use raytrail_conformance::NamedScene;
 use std::path::Path;
+
+/// The `--scene` name of the built-in scene: the conformance suite's sphereflake (25,220
+/// triangles), generated, so that the main job needs no file.
+pub const BUILTIN_SCENE: &str = "builtin";
 
 /// The switch that makes mesh loading strict (`run`, `trace`, `rays`, `bench`, `render`): an
 /// element that is not a triangle or polygon (a face of fewer than three vertices, an OBJ line or
@@ -477,7 +481,7 @@ pub struct RenderArgs {
 /// (triangles collapsed to one point, which PLOC clusters in quadratic time).
 pub fn ploc_note(builder: Builder, scene: &raytrail::core::scene::Scene) {
     if builder == Builder::Ploc {
-        if let Some(why) = raytrail::cpu::ploc::ploc_fallback(scene.triangles()) {
+        if let Some(why) = raytrail::build::ploc::ploc_fallback(scene.triangles()) {
             eprintln!("warning: --builder ploc: {why}");
         }
     }
@@ -511,9 +515,23 @@ pub fn check_input(flag: &str, path: &str) -> Result<(), Failure> {
 /// Loads a scene (a mesh file or `builtin`) with `options`; returns the warning line to print
 /// when loading skipped elements (print it with [`warn`] once any progress line is done).
 pub fn load_scene(path: &str, options: &LoadOptions) -> Result<(NamedScene, LoadReport, Option<String>), String> {
-    let (named, report) = raytrail::load_scene_with(path, options)?;
+    if path == BUILTIN_SCENE {
+        return Ok((builtin_scene(), LoadReport::default(), None));
+    }
+    let (mesh, report) = raytrail::mesh::load_with(Path::new(path), options).map_err(|e| e.to_string())?;
+    let scene = mesh.to_scene().map_err(|e| match report.skipped {
+        0 => format!("{path}: {e}"),
+        1 => format!("{path}: {e} (1 element that is not a triangle or polygon was skipped)"),
+        n => format!("{path}: {e} ({n} elements that are not triangles or polygons were skipped)"),
+    })?;
+    let name = Path::new(path).file_name().map_or(path.to_string(), |n| n.to_string_lossy().into_owned());
     let warning = skipped_warning(path, &report);
-    Ok((named, report, warning))
+    Ok((NamedScene::new(name, scene), report, warning))
+}
+
+/// The built-in scene ([`BUILTIN_SCENE`]).
+pub fn builtin_scene() -> NamedScene {
+    raytrail_conformance::suite::generated_scene("sphereflake")
 }
 
 /// The one warning line for what loading `path` skipped, if it skipped anything.

@@ -244,7 +244,7 @@ mod tests {
 
     #[test]
     fn generated_sets_cover_every_ray_kind() {
-        let scene = raytrail::load_scene("builtin").unwrap().scene;
+        let scene = crate::args::builtin_scene().scene;
         let bvh = raytrail::Builder::Sah.build(&scene).unwrap();
         let sets = generated_sets(&CpuBackend::new(), &scene, &bvh, ViewChoice::Outside, 16, 12).unwrap();
         let labels: Vec<&str> = sets.iter().map(|s| s.label.as_str()).collect();

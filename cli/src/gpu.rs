@@ -1,13 +1,13 @@
 //! The main job's GPU part: the same rays and methods on the wgpu backend, timed, and checked
 //! against the CPU ray by ray.
 
-use raytrail::conformance::check::{check_against, Context, Mismatch};
 use raytrail::core::method::{Method, Query};
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::{Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::gpu::{WgpuBackend, WgpuScene};
+use raytrail_conformance::check::{check_against, Context, Mismatch};
 use std::sync::Arc;
 
 /// Median seconds of a method's GPU passes.

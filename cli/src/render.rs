@@ -10,13 +10,13 @@ use crate::limits::{check_image, try_vec};
 use crate::progress::timed;
 use crate::trace::raster_rays;
 use glam::Vec3;
-use raytrail::conformance::rng::Pcg32;
 use raytrail::core::method::{Method, Query};
 use raytrail::core::scene::Scene;
 use raytrail::core::trace::{Record, Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::CpuBackend;
 use raytrail_cli::write::write_atomically;
+use raytrail_conformance::rng::Pcg32;
 use std::sync::Arc;
 
 /// Background of pixels whose ray hits nothing (normals and ao).

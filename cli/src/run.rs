@@ -6,8 +6,6 @@ use crate::args::{builder, check_input, load_scene, warn, Outcome, RunArgs};
 use crate::limits::check_image;
 use crate::median::median;
 use crate::progress::{timed, Progress};
-use raytrail::conformance::check::{check_ray_set, Context, Mismatch};
-use raytrail::conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
 use raytrail::core::method::{Bvh2Method, KdMethod, Method, Query};
 use raytrail::core::observe::Counters;
 use raytrail::core::prepared::{BuiltHash, PreparedScene};
@@ -17,6 +15,8 @@ use raytrail::core::wide::WideStats;
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::Builder;
+use raytrail_conformance::check::{check_ray_set, Context, Mismatch};
+use raytrail_conformance::rays::{default_light, diffuse, primary, scene_epsilon, shadow, RAY_SEED};
 use std::sync::Arc;
 
 /// One method's figures on a ray set: median seconds and counters.

@@ -5,16 +5,16 @@
 
 use crate::args::{Failure, Outcome, StressArgs};
 use crate::progress::Progress;
-use raytrail::conformance::stress::{all_cases, run_case, Tally};
 use raytrail::core::method::Method;
 use raytrail::core::trace::Trace;
 use raytrail::cpu::CpuBackend;
 use raytrail::gpu::WgpuBackend;
+use raytrail_conformance::stress::{all_cases, run_case, Tally};
 
 /// Runs the suite on the CPU and, unless `--no-gpu` or without an adapter, on the GPU; exit
 /// status 1 when any ray disagrees with the exact reference.
 pub fn main(a: StressArgs) -> Outcome {
-    let cases = all_cases().map_err(Failure::Run)?;
+    let cases = all_cases().map_err(|e| Failure::Run(e.to_string()))?;
     let cpu = CpuBackend::new();
     let gpu = if a.no_gpu {
         println!("GPU: skipped (--no-gpu)");

@@ -4,13 +4,13 @@ use crate::args::{builder, check_input, check_output, load_scene, method_or_auto
 use crate::args::{RaysArgs, TraceArgs};
 use crate::limits::{check_count, check_image, try_vec};
 use crate::progress::timed;
-use raytrail::conformance::rays::{primary_from, Camera};
-use raytrail::core::mesh::LoadOptions;
 use raytrail::core::method::Query;
 use raytrail::core::trace::{Trace, TraceOptions, TriangleTestKind};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::CpuBackend;
+use raytrail::mesh::LoadOptions;
 use raytrail_cli::npy;
+use raytrail_conformance::rays::{primary_from, Camera};
 use std::sync::Arc;
 
 /// Bytes a traced ray takes: the ray and its hit.
@@ -101,7 +101,7 @@ pub fn rays_main(a: RaysArgs) -> Outcome {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use raytrail::conformance::rays::morton_order;
+    use raytrail_conformance::rays::morton_order;
 
     #[test]
     fn raster_order_is_morton_order_reordered() {

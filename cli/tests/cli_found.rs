@@ -1,9 +1,8 @@
 //! One test per command-line problem the "ecosystem command line" issue found: each failed before
 //! the command line moved to clap, atomic writes, limits and `render`.
 
-use raytrail::conformance::rays::{primary, Camera};
-use raytrail::load_scene;
 use raytrail_cli::npy;
+use raytrail_conformance::rays::{primary, Camera};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -243,7 +242,7 @@ fn rays_in_raster_or_morton_order() {
         .status
         .success());
     assert!(run(&[&["rays", "--scene", "builtin", "--out", p(&morton)][..], &size].concat()).status.success());
-    let scene = load_scene("builtin").unwrap().scene;
+    let scene = raytrail_conformance::suite::generated_scene("sphereflake").scene;
     let camera = Camera::framing(scene.bounds());
     let got = npy::read_rays(&raster).unwrap();
     for (i, ray) in got.iter().enumerate() {

@@ -8,7 +8,7 @@ fn stress_reports_every_case_and_agrees() {
     let out = Command::new(env!("CARGO_BIN_EXE_raytrail")).args(["stress", "--no-gpu"]).output().unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
-    let names = raytrail::conformance::stress::case_names().expect("the cases can be made");
+    let names = raytrail_conformance::stress::case_names().expect("the cases can be made");
     for name in &names {
         assert!(stdout.lines().any(|l| l.starts_with(name.as_str())), "case '{name}' not reported:\n{stdout}");
     }

@@ -243,7 +243,7 @@ impl<B: Trace> Run<B> {
     }
 
     fn ploc(&mut self, named: &NamedScene, size: RaySetSize) {
-        let bvh = raytrail_cpu::ploc::build_ploc(named.scene.triangles(), 63).expect("build");
+        let bvh = raytrail_build::ploc::build_ploc(named.scene.triangles(), 63).expect("build");
         self.case(named, "ploc", bvh, size);
     }
 }

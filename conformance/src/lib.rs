@@ -24,7 +24,7 @@ pub mod stress;
 pub mod suite;
 
 pub use check::{check_ray_set, compare, Context, Difference, Mismatch};
-pub use paths::{load_mesh_scene, scenes_dir, MESH_FILES};
+pub use paths::{find_mesh, load_mesh_scene, scenes_dir, SceneFileError, MESH_FILES};
 pub use rays::{ray_sets, RaySet, RaySetKind, RaySetSize};
 pub use reference::SerialBackend;
 pub use scenes::{generated, NamedScene};

@@ -9,7 +9,7 @@
 //! backend does not support fails the case: the suite never passes over a method in silence.
 
 use crate::check::{check_against, check_complete, leaf_of_prim, Context, Mismatch};
-use crate::paths::{load_mesh_scene, scenes_dir};
+use crate::paths::{find_mesh, load_mesh_scene};
 use crate::rays::{ray_sets, RaySetSize};
 use crate::reference::SerialBackend;
 use crate::scenes::{generated, tiny_cases, NamedScene};
@@ -24,9 +24,6 @@ use raytrail_core::{Hit, Ray};
 use std::any::Any;
 use std::fmt::Display;
 use std::sync::{Arc, OnceLock};
-
-/// Set to 1 to let the mesh cases pass without the scenes folder (they then print why).
-pub const ALLOW_MISSING: &str = "RAYTRAIL_ALLOW_MISSING_SCENES";
 
 /// Set to 1 to make a backend whose constructor fails (no GPU adapter) fail the suite instead of
 /// skipping it (CI sets it, with a software Vulkan driver installed).
@@ -63,7 +60,7 @@ pub enum Case {
 /// Runs one case on `backend`; panics with a loud report on any mismatch.
 pub fn run_case<B: Trace>(backend: &B, case: Case) {
     let sah = |s: &NamedScene| SahBuilder::default().build(s.scene.triangles()).expect("SAH build");
-    let ploc = |s: &NamedScene| raytrail_cpu::ploc::build_ploc(s.scene.triangles(), 63).expect("PLOC build");
+    let ploc = |s: &NamedScene| raytrail_build::ploc::build_ploc(s.scene.triangles(), 63).expect("PLOC build");
     match case {
         Case::SharedEdgeGrid => check_scene(backend, &generated_scene("shared_edge_grid"), sah, GENERATED_RAYS),
         Case::Sphereflake | Case::TriangleSoup => {
@@ -129,19 +126,12 @@ pub fn generated_scene(name: &str) -> NamedScene {
     generated().into_iter().find(|s| s.name == name).unwrap_or_else(|| panic!("no generated scene {name}"))
 }
 
-/// Loads a mesh of the suite; a missing scenes folder fails unless [`ALLOW_MISSING`] is 1.
+/// Loads a mesh of the suite; a missing one is skipped with a printed line ([`find_mesh`]), or
+/// fails the case where [`REQUIRE_SCENES`](crate::paths::REQUIRE_SCENES) is 1. A mesh that is
+/// there but does not load always fails.
 pub fn mesh(file: &str) -> Option<NamedScene> {
-    match load_mesh_scene(file) {
-        Ok(s) => Some(s),
-        Err(e) if std::env::var(ALLOW_MISSING).as_deref() == Ok("1") => {
-            eprintln!("SKIPPED {file}: {e} ({ALLOW_MISSING}=1)");
-            None
-        }
-        Err(e) => panic!(
-            "{e}\n(scenes are read from {}; set RAYTRAIL_SCENES or run the fetch script)",
-            scenes_dir().display()
-        ),
-    }
+    find_mesh(file)?;
+    Some(load_mesh_scene(file).unwrap_or_else(|e| panic!("{e}")))
 }
 
 /// Runs every method for both queries on every ray set of `named`, with the tree `build` makes,

@@ -7,16 +7,16 @@ use raytrail_conformance::rays::primary;
 use raytrail_conformance::rng::Pcg32;
 use raytrail_conformance::SerialBackend;
 use raytrail_core::bvh2::SahBuilder;
-use raytrail_core::mesh::{load_with, LoadOptions};
 use raytrail_core::method::{Method, Query};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::scene::{Mesh, Scene};
 use raytrail_core::trace::{Trace, TraceOptions};
 use raytrail_core::{Hit, Ray};
+use raytrail_mesh::{load_with, LoadOptions};
 use std::path::PathBuf;
 use std::sync::Arc;
 
-#[path = "../../core/tests/common/mesh_writers.rs"]
+#[path = "../../mesh/tests/common/mesh_writers.rs"]
 mod mesh_writers;
 
 /// A closed box with a hole-riddled lid and a tilted fan inside: shared vertices, polygons of

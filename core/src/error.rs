@@ -37,6 +37,15 @@ pub enum Error {
     },
     /// A tree handed to [`crate::bvh2::Bvh2::from_nodes`] is malformed.
     MalformedTree(&'static str),
+    /// A tree handed to [`crate::prepared::PreparedScene::new`] does not bound the scene it is
+    /// given: it was built for other triangles (another scene, or this one before its vertices
+    /// moved), and tracing it would miss what lies outside its boxes.
+    TreeMismatch {
+        /// The node whose box fails to hold what lies below it (its index in canonical order).
+        node: usize,
+        /// What does not fit.
+        why: &'static str,
+    },
     /// The hash tables could not be built within the table-size limit.
     HashConstruction {
         /// Number of keys.
@@ -98,6 +107,9 @@ impl fmt::Display for Error {
                 write!(f, "{what} ({size}) exceeds the 2^30 addresses node references allow")
             }
             Error::MalformedTree(why) => write!(f, "malformed tree: {why}"),
+            Error::TreeMismatch { node, why } => {
+                write!(f, "the tree was not built for this scene: node {node}: {why}")
+            }
             Error::HashConstruction { keys, table_size } => {
                 write!(f, "no perfect hash for {keys} keys up to table size {table_size}")
             }

@@ -2,8 +2,8 @@
 //!
 //! Everything a traversal needs and nothing it does not: ray, box and hit types, the robust box and
 //! triangle tests, key and bit-trail arithmetic, node layouts, perfect hashing and the traversal
-//! state machines. Builders and table construction need the `alloc` feature; file loading needs
-//! `std` (the default).
+//! state machines. Builders and table construction need the `alloc` feature; timing needs `std` (the
+//! default). Mesh files are the `raytrail-mesh` crate.
 //!
 //! The canonical tree ([`bvh2::Bvh2`]) is the single source of truth: every layout is a view of it,
 //! and node identity in enumerations is the node's index in the canonical tree.
@@ -22,8 +22,6 @@ pub mod hash;
 pub mod intersect;
 pub mod kd;
 pub mod key;
-#[cfg(feature = "std")]
-pub mod mesh;
 pub mod method;
 pub mod observe;
 #[cfg(feature = "alloc")]

@@ -114,6 +114,9 @@ pub struct Report {
     /// Rays refused: answered [`Hit::REFUSED`] because no method can answer them reliably
     /// ([`PreparedScene::frame_rays`]). Never counted as misses.
     pub refused: usize,
+    /// Rays that cannot hit anything as given ([`Ray::is_traceable`] is false: a NaN or infinite
+    /// component, a zero direction, a NaN bound or `tmin > tmax`), answered as misses.
+    pub untraceable: usize,
 }
 
 impl Report {
@@ -128,6 +131,7 @@ impl Report {
             enumerations: None,
             stream: None,
             refused: 0,
+            untraceable: 0,
         }
     }
 
@@ -153,8 +157,8 @@ pub fn check_buffers(rays: &[Ray], hits: &[Hit]) -> Result<(), Error> {
 
 /// Traces a batch in `scene`'s frame ([`PreparedScene::frame_rays`]): checks the buffers, hands
 /// the framed rays to `trace`, puts the hits back in the caller's frame and counts the refused
-/// rays in the report. Every backend's [`Trace::trace`] goes through it, so all of them scale,
-/// move and refuse rays alike.
+/// and the untraceable rays in the report. Every backend's [`Trace::trace`] goes through it, so
+/// all of them scale, move, refuse and count rays alike.
 pub fn trace_framed(
     scene: &PreparedScene,
     rays: &[Ray],
@@ -165,6 +169,7 @@ pub fn trace_framed(
     let framed = scene.frame_rays(rays);
     let mut report = trace(framed.rays(), hits)?;
     report.refused = framed.finish(hits);
+    report.untraceable = rays.iter().filter(|r| !r.is_traceable()).count();
     Ok(report)
 }
 

@@ -2,7 +2,8 @@
 //! leaf) and a brute-force ray check, on generated scenes and the real meshes.
 //!
 //! The real meshes are read from `../shared/scenes` beside the workspace (`RAYTRAIL_SCENES`
-//! overrides it); a missing folder fails unless `RAYTRAIL_ALLOW_MISSING_SCENES=1`. Build times
+//! overrides it); a missing one is skipped with a printed line, or fails where
+//! `RAYTRAIL_REQUIRE_SCENES=1`. Build times
 //! and tree figures: `cargo test --release -p raytrail-core --test kd_build -- --ignored
 //! --nocapture`.
 #![cfg(feature = "std")]
@@ -528,7 +529,7 @@ mod kd {
 
     fn load(file: &str) -> Option<Vec<Triangle>> {
         let path = scene_file(file)?;
-        let mesh = raytrail_core::mesh::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let mesh = raytrail_mesh::load(&path).unwrap_or_else(|e| panic!("{e}"));
         Some(mesh.to_scene().unwrap_or_else(|e| panic!("{file}: {e}")).triangles().to_vec())
     }
 

@@ -5,7 +5,7 @@
 //! - [`sample`]: the sample and the CPU backend's clock;
 //! - [`needs`]: whether 64-bit keys, hash tables, the `f64` fallback, the disjoint mask and the
 //!   slack are needed;
-//! - [`shaders`]: the wgpu kernels the choices compile.
+//! - `shaders` (feature `gpu`): the wgpu kernels the choices compile.
 //!
 //! The tables each method builds, and their sizes, come from the core's
 //! [`Part`](raytrail_core::prepared::Part).
@@ -13,6 +13,7 @@
 pub mod choice;
 pub mod needs;
 pub mod sample;
+#[cfg(feature = "gpu")]
 pub mod shaders;
 
 use choice::Choice;
@@ -116,6 +117,7 @@ impl SceneAnalysis {
     }
 
     /// The wgpu kernels the choices compile.
+    #[cfg(feature = "gpu")]
     pub fn variants(&self) -> Vec<raytrail_wgpu::compose::Variant> {
         let chosen: Vec<(Method, Query)> = self.choices.iter().map(|c| (c.choice.method, c.query)).collect();
         shaders::variants_for(self.key_width, &chosen)
@@ -309,10 +311,13 @@ mod tests {
         let (all_bytes, _) = a.cost_of(&Method::ALL);
         assert!(chosen_bytes < all_bytes);
         assert_eq!(a.needs.hash_tables.needed, chosen.iter().any(|m| m.needs_hash()));
+        #[cfg(feature = "gpu")]
         assert!(!a.variants().is_empty() && a.variants().len() <= 2);
         // No rays: nothing chosen, nothing compiled.
         let none = analyze(&scene, &bvh, &[], &backend, &mut |_| {}).unwrap();
-        assert!(none.choices.is_empty() && none.variants().is_empty());
+        assert!(none.choices.is_empty());
+        #[cfg(feature = "gpu")]
+        assert!(none.variants().is_empty());
     }
 
     #[test]

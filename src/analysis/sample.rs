@@ -113,13 +113,24 @@ impl SampleClock for CpuClock<'_> {
 /// Fails with [`Error::NotPrepared`] when the scene holds none of the candidates, and
 /// [`Error::InvalidParameter`] for an empty batch.
 pub fn choose_on_cpu(backend: &CpuBackend, scene: &CpuScene, rays: &[Ray], query: Query) -> Result<Choice, Error> {
+    choose_among(&CANDIDATES, backend, scene, rays, query)
+}
+
+/// As [`choose_on_cpu`], among `candidates` (those `scene` holds) instead of [`CANDIDATES`].
+pub fn choose_among(
+    candidates: &[Method],
+    backend: &CpuBackend,
+    scene: &CpuScene,
+    rays: &[Ray],
+    query: Query,
+) -> Result<Choice, Error> {
     if rays.is_empty() {
         return Err(Error::InvalidParameter {
             name: "rays",
             why: "a method is chosen for a batch of at least one ray",
         });
     }
-    let candidates: Vec<Method> = CANDIDATES.into_iter().filter(|&m| scene.0.check_prepared(m).is_ok()).collect();
+    let candidates: Vec<Method> = candidates.iter().copied().filter(|&m| scene.0.check_prepared(m).is_ok()).collect();
     if candidates.is_empty() {
         return Err(Error::NotPrepared { method: "auto", missing: "any of its candidate methods' structures" });
     }

@@ -4,8 +4,6 @@
 //! rays are split into chunks traced in parallel, each chunk through the core's state machines
 //! monomorphized for the tree's key width, the triangle test and what is recorded, so the fast
 //! path carries no observer at all.
-//!
-//! The crate also holds the obvhs (PLOC) BVH2 builder ([`ploc`]).
 #![warn(missing_docs)]
 
 #[cfg(target_arch = "x86_64")]
@@ -21,10 +19,11 @@ mod bvh2;
 mod chunk;
 mod kd;
 mod keyed;
-pub mod ploc;
 mod stream;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod test_rng;
 mod wide;
 
 pub use backend::{CpuBackend, CpuScene};
+/// Why [`CpuBackend::with_threads`] could not make its pool (rayon's error).
+pub use rayon::ThreadPoolBuildError;

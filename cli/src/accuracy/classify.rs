@@ -2,7 +2,7 @@
 //! of a sample.
 //!
 //! Closest-hit answers are judged by the exact reference's own verdict
-//! ([`raytrail::conformance::exact::verdict`]: exact ties, and the one rounding tolerance
+//! ([`raytrail_conformance::exact::verdict`]: exact ties, and the one rounding tolerance
 //! `delta` near edges, are no error); a disagreement is then split by what is wrong:
 //! - **false miss**: the method misses, the ray hits a triangle well inside it;
 //! - **false hit**: the method hits, the ray hits nothing (and passes no triangle within `delta`);
@@ -19,11 +19,11 @@
 //! The `t` error is counted in ulps of `f32` at the exact `t` (rounded to `f64` first, which adds
 //! under `2^-29` ulps) for every answer naming a triangle the ray hits.
 
-use raytrail::conformance::exact::triangle::exact_hit;
-use raytrail::conformance::exact::{judge, ExactAnswer, Judgement, Tolerance};
 use raytrail::core::geometry::Triangle;
 use raytrail::core::method::Query;
 use raytrail::core::{Hit, Ray};
+use raytrail_conformance::exact::triangle::exact_hit;
+use raytrail_conformance::exact::{judge, ExactAnswer, Judgement, Tolerance};
 use serde::Serialize;
 
 /// What one answer is.
@@ -164,7 +164,7 @@ impl Tally {
 mod tests {
     use super::*;
     use glam::Vec3;
-    use raytrail::conformance::exact::closest_hit;
+    use raytrail_conformance::exact::closest_hit;
 
     /// Two unit squares at z = -1 (triangles 0, 1, sharing the diagonal) and a big triangle
     /// below them at z = -2 (2).

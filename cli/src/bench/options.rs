@@ -2,12 +2,13 @@
 
 use super::rays::RayKind;
 use super::view::ViewChoice;
+use crate::args::BUILTIN_SCENE;
 use crate::args::{LoadFlags, AUTO, BUILDERS};
 use clap::Parser;
 use raytrail::core::method::Method;
 use raytrail::core::stream::{StreamParams, MAX_PACKET};
 use raytrail::gpu::{Dispatch, GpuConfig};
-use raytrail::{Builder, BUILTIN_SCENE};
+use raytrail::Builder;
 
 /// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
 /// follow from the primary hits). With the three scenes of BENCHMARKS.md (Sponza, the kitchen, the
@@ -278,7 +279,10 @@ impl Options {
             baseline,
             json: a.json.clone(),
             plot: a.plot.clone(),
-            builder: Builder::from_name(&a.builder)?,
+            builder: Builder::from_name(&a.builder).ok_or_else(|| {
+                let known: Vec<&str> = Builder::ALL.iter().map(|b| b.name()).collect();
+                format!("unknown builder '{}' (known: {})", a.builder, known.join(", "))
+            })?,
             ao_rays,
             no_gpu: a.no_gpu,
             view: ViewChoice::from_name(&a.view)?,

@@ -7,11 +7,11 @@
 
 use super::view::View;
 use glam::Vec3;
-use raytrail::conformance::rays::{default_light, diffuse, primary_from, scene_epsilon, shadow, RAY_SEED};
-use raytrail::conformance::rng::Pcg32;
 use raytrail::core::method::Query;
 use raytrail::core::scene::Scene;
 use raytrail::core::{Hit, Ray};
+use raytrail_conformance::rays::{default_light, diffuse, primary_from, scene_epsilon, shadow, RAY_SEED};
+use raytrail_conformance::rng::Pcg32;
 
 /// Length of an ambient-occlusion ray, as a fraction of the scene's diagonal.
 pub const AO_RADIUS: f32 = 0.05;
@@ -268,7 +268,7 @@ mod tests {
     #[test]
     fn the_outside_view_is_the_conformance_framing() {
         let scene = floor();
-        assert_eq!(primary_rays(&scene, View::Outside, 8, 6), raytrail::conformance::rays::primary(&scene, 8, 6));
+        assert_eq!(primary_rays(&scene, View::Outside, 8, 6), raytrail_conformance::rays::primary(&scene, 8, 6));
         let inside = primary_rays(&scene, View::Inside, 8, 6);
         assert_eq!(inside.len(), 48);
         let eye = View::Inside.camera(scene.bounds()).eye;

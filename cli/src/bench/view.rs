@@ -9,9 +9,9 @@
 //! (counter-clockwise) side. Sponza, the kitchen and the Cornell box pass with 100% and 100%;
 //! the bunny, the dragon and the teapot, with 100% hits, show 0% front sides.
 
-use raytrail::conformance::rays::Camera;
 use raytrail::core::geometry::Triangle;
 use raytrail::core::{Aabb, Hit, Ray};
+use raytrail_conformance::rays::Camera;
 
 /// Least share of the inside view's primary rays that hit, for `--view auto` to measure it.
 pub const ROOM_HITS: f64 = 0.9;

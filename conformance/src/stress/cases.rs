@@ -62,7 +62,7 @@ fn from_afar(tris: &[Triangle], center: Vec3, size: f32, distance: f32, seed: u6
 
 /// Every case, teapot regressions included (the teapot from the scenes folder; an error names
 /// it when missing).
-pub fn all_cases() -> Result<Vec<StressCase>, String> {
+pub fn all_cases() -> Result<Vec<StressCase>, crate::paths::SceneFileError> {
     let mut out = Vec::new();
     let unit = sphere(|p| p);
     // Rays from the centre through every vertex and every edge's midpoint of a closed mesh: each
@@ -221,6 +221,6 @@ pub fn all_cases() -> Result<Vec<StressCase>, String> {
 }
 
 /// The names of [`all_cases`], for reports.
-pub fn case_names() -> Result<Vec<String>, String> {
+pub fn case_names() -> Result<Vec<String>, crate::paths::SceneFileError> {
     Ok(all_cases()?.into_iter().map(|c| c.name).collect())
 }

@@ -1,3 +1,4 @@
+use crate::geometry::Triangle;
 use crate::key::KeyWidth;
 use crate::{Aabb, Error};
 use alloc::vec::Vec;
@@ -132,6 +133,37 @@ impl Bvh2 {
         }
         stats.key_width = KeyWidth::for_depth(stats.depth).ok_or(Error::TreeTooDeep { depth: stats.depth, max: 63 })?;
         Ok(Bvh2 { nodes: out, prim_order: new_order, stats })
+    }
+
+    /// Checks that this tree bounds `triangles`: one primitive id per triangle, every leaf's box
+    /// holding its triangles' boxes and every internal box its children's. A tree built for other
+    /// triangles fails ([`Error::TreeMismatch`]); a tree that passes finds every hit, since no
+    /// triangle lies outside the boxes a ray must enter to reach it. Linear in the tree's size.
+    pub fn check_bounds(&self, triangles: &[Triangle]) -> Result<(), Error> {
+        if self.prim_order.len() != triangles.len() {
+            return Err(Error::TreeMismatch {
+                node: 0,
+                why: "its primitive count differs from the scene's triangle count",
+            });
+        }
+        for (i, node) in self.nodes.iter().enumerate() {
+            let fits = match node.kind {
+                NodeKind::Internal { left, right } => [left, right]
+                    .iter()
+                    .all(|&c| self.nodes.get(c as usize).is_some_and(|child| node.bounds.contains(&child.bounds))),
+                NodeKind::Leaf { first, count } => self.prim_order[first as usize..(first + count) as usize]
+                    .iter()
+                    .all(|&p| triangles.get(p as usize).is_some_and(|t| node.bounds.contains(&t.bounds()))),
+            };
+            if !fits {
+                let why = match node.kind {
+                    NodeKind::Internal { .. } => "its box does not hold a child's box",
+                    NodeKind::Leaf { .. } => "its box does not hold one of its triangles",
+                };
+                return Err(Error::TreeMismatch { node: i, why });
+            }
+        }
+        Ok(())
     }
 
     /// Nodes in canonical order.

@@ -131,7 +131,11 @@ pub(crate) fn seconds_since(_start: Option<f64>) -> f64 {
 
 impl PreparedScene {
     /// Derives what `methods` need from `bvh` over `scene`.
+    ///
+    /// Fails with [`Error::TreeMismatch`] when `bvh` does not bound `scene`'s triangles (a tree
+    /// built for another scene, or for this one before its vertices moved; [`Bvh2::check_bounds`]).
     pub fn new(scene: &Scene, bvh: Bvh2, methods: &[Method]) -> Result<PreparedScene, Error> {
+        bvh.check_bounds(scene.triangles())?;
         let (scaled, bvh, exponent) = normalize::normalize(scene, bvh)?;
         let scene = scaled.as_ref().unwrap_or(scene);
         let tris = scene.triangles();

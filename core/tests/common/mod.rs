@@ -34,25 +34,10 @@ pub fn soup(n: usize, seed: u64, size: f32) -> Vec<Triangle> {
         .collect()
 }
 
-/// A mesh of `shared/scenes` (or `RAYTRAIL_SCENES`); `None`, with a printed reason, only when
-/// `RAYTRAIL_ALLOW_MISSING_SCENES=1` and the file is missing; otherwise a missing file fails.
+/// A mesh of the suite ([`raytrail_conformance::paths::find_mesh`]): `None`, after one printed
+/// line saying why, when it is missing, unless `RAYTRAIL_REQUIRE_SCENES=1` makes that a failure.
 pub fn scene_file(file: &str) -> Option<std::path::PathBuf> {
-    let dir = std::env::var_os("RAYTRAIL_SCENES")
-        .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes")));
-    let path = dir.join(file);
-    if path.is_file() {
-        return Some(path);
-    }
-    if std::env::var("RAYTRAIL_ALLOW_MISSING_SCENES").as_deref() == Ok("1") {
-        println!("skipped: {} not found (RAYTRAIL_ALLOW_MISSING_SCENES=1)", path.display());
-        return None;
-    }
-    panic!(
-        "test scene {} not found: point RAYTRAIL_SCENES at the scenes folder \
-         (see shared/scenes/SOURCES.md), or set RAYTRAIL_ALLOW_MISSING_SCENES=1 to skip",
-        path.display()
-    );
+    raytrail_conformance::paths::find_mesh(file)
 }
 
 /// A soup of `n` triangles (edges up to 1.5) collapsed 4-wide by the pull-up and 8-wide by

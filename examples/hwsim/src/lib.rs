@@ -99,14 +99,14 @@ impl Scenario {
     /// Builds the SAH tree of `scene`, prepares it for every method ([`Method::ALL`]: the BVH2
     /// layouts and hashes, the kd-tree, the wide trees) and makes `kind` rays from a
     /// `width` x `height` camera framing the scene (shadow and diffuse rays start at its hits).
-    pub fn new(scene: Scene, kind: RayKind, width: u32, height: u32) -> Result<Scenario, String> {
-        let bvh = SahBuilder::default().build(scene.triangles()).map_err(|e| e.to_string())?;
-        let prepared = PreparedScene::new(&scene, bvh, &Method::ALL).map_err(|e| e.to_string())?;
+    pub fn new(scene: Scene, kind: RayKind, width: u32, height: u32) -> Result<Scenario, raytrail_core::Error> {
+        let bvh = SahBuilder::default().build(scene.triangles())?;
+        let prepared = PreparedScene::new(&scene, bvh, &Method::ALL)?;
         let camera = primary(&scene, width, height);
         let rays = match kind {
             RayKind::Primary => camera,
             RayKind::Shadow | RayKind::Diffuse => {
-                let hits = reference_hits(&prepared, &camera, Query::Closest).map_err(|e| e.to_string())?;
+                let hits = reference_hits(&prepared, &camera, Query::Closest)?;
                 let bounds = scene.bounds();
                 if kind == RayKind::Shadow {
                     shadow(&camera, &hits, default_light(bounds), scene_epsilon(bounds))

@@ -108,12 +108,12 @@ fn load(scene: &str) -> Result<(String, raytrail_core::scene::Scene), String> {
         Ok(p) if p.is_file() => p.to_string_lossy().into_owned(),
         _ => scene.to_string(),
     };
-    raytrail_conformance::paths::load_mesh_scene(&file).map(|s| (s.name, s.scene))
+    raytrail_conformance::paths::load_mesh_scene(&file).map(|s| (s.name, s.scene)).map_err(|e| e.to_string())
 }
 
 fn run(a: &Args) -> Result<(), String> {
     let (name, scene) = load(&a.scene)?;
-    let s = Scenario::new(scene, a.rays, a.width, a.height)?;
+    let s = Scenario::new(scene, a.rays, a.width, a.height).map_err(|e| e.to_string())?;
     let stats = s.prepared.bvh.stats();
     println!(
         "scene {name}: {} triangles; SAH tree: {} internal nodes, {} leaves, depth {}, {} keys",

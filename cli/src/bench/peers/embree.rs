@@ -145,13 +145,14 @@ impl BenchTarget for Embree {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::args::builtin_scene;
     use crate::bench::agreement::compare;
-    use raytrail::conformance::rays::{primary, shadow};
     use raytrail::core::method::{Bvh2Method, Method};
     use raytrail::core::prepared::PreparedScene;
     use raytrail::core::trace::{Trace, TraceOptions};
     use raytrail::cpu::{CpuBackend, CpuScene};
-    use raytrail::{load_scene, Builder};
+    use raytrail::Builder;
+    use raytrail_conformance::rays::{primary, shadow};
 
     /// The stack method's hits on `rays`.
     fn stack_hits(scene: &Scene, rays: &[Ray], query: Query) -> Vec<Hit> {
@@ -166,7 +167,7 @@ mod tests {
 
     #[test]
     fn embree_agrees_with_the_stack_method() {
-        let named = load_scene("builtin").unwrap();
+        let named = builtin_scene();
         let scene = &named.scene;
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
         let (embree, built) = Embree::new(scene, 2).unwrap();
@@ -192,7 +193,7 @@ mod tests {
 
         let bounds = scene.bounds();
         let light = bounds.center() + glam::Vec3::new(0.0, 2.0, 0.5) * bounds.extent().length();
-        let shadows = shadow(&rays, &expected, light, raytrail::conformance::rays::scene_epsilon(bounds));
+        let shadows = shadow(&rays, &expected, light, raytrail_conformance::rays::scene_epsilon(bounds));
         let expected = stack_hits(scene, &shadows, Query::Any);
         let mut got = vec![Hit::MISS; shadows.len()];
         embree.trace(&pool, &shadows, Query::Any, &mut got).unwrap();

@@ -5,15 +5,14 @@
 //! `scripts/fetch_scenes.sh`) are read from `$RAYTRAIL_SCENES`, `shared/scenes` beside the
 //! checkout or `scenes/` in it, and their tests are skipped with a printed reason where none of
 //! those has them.
-#![cfg(feature = "std")]
 
 use glam::Vec3;
-use raytrail_core::mesh::{load, load_bytes, load_bytes_with, load_with, write_sources_csv, LoadOptions, Source};
 use raytrail_core::scene::Mesh;
+use raytrail_mesh::{load, load_bytes, load_bytes_with, load_with, write_sources_csv, LoadOptions, Source};
 use std::path::{Path, PathBuf};
 
 /// A real mesh fetched by `scripts/fetch_scenes.sh`, or `None` (with a printed reason) when no
-/// scenes folder has it.
+/// scenes folder has it; with `RAYTRAIL_REQUIRE_SCENES=1` a missing file fails the test.
 fn fetched(file: &str) -> Option<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut dirs: Vec<PathBuf> =
@@ -22,7 +21,9 @@ fn fetched(file: &str) -> Option<PathBuf> {
     if let Some(path) = dirs.iter().map(|d| d.join(file)).find(|p| p.is_file()) {
         return Some(path);
     }
-    println!("skipped: {file} not found in {dirs:?} (scripts/fetch_scenes.sh fetches it)");
+    let why = format!("not found in {dirs:?} (scripts/fetch_scenes.sh fetches it)");
+    assert!(!raytrail_conformance::paths::scenes_required(), "missing test model {file}: {why}");
+    raytrail_conformance::paths::say_skipped(file, &why);
     None
 }
 

@@ -31,13 +31,13 @@
 //! ([`Source::Gltf`]).
 
 use super::{LoadOptions, LoadReport, MeshError, Source, MAX_TRIANGLES, MAX_VERTICES};
-use crate::scene::Mesh;
 use ::gltf::json;
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec3};
 use json::accessor::{ComponentType, GenericComponentType, IndexComponentType, Type};
 use json::mesh::{Mode, Semantic};
 use json::validation::Checked;
+use raytrail_core::scene::Mesh;
 use std::borrow::Cow;
 use std::format;
 use std::io::Read;

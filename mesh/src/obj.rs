@@ -20,8 +20,8 @@
 //! repeated `n - 2` times, line up with its triangles (checked against the count it returns).
 
 use super::{LoadOptions, LoadReport, MeshError, Source};
-use crate::scene::Mesh;
 use glam::Vec3;
+use raytrail_core::scene::Mesh;
 use std::borrow::Cow;
 use std::format;
 use std::io::{self, BufRead, Read};

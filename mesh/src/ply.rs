@@ -8,8 +8,8 @@
 //! always, not counted. The source of a triangle is its face element's index ([`Source::Face`]).
 
 use super::{LoadOptions, LoadReport, MeshError, Source};
-use crate::scene::Mesh;
 use glam::Vec3;
+use raytrail_core::scene::Mesh;
 use std::collections::HashSet;
 use std::format;
 use std::string::{String, ToString};

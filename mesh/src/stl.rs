@@ -26,8 +26,8 @@
 //! triangle is its facet's index, counted across solids ([`Source::Facet`]).
 
 use super::{show, LoadOptions, LoadReport, MeshError, Source, MAX_TRIANGLES, MAX_VERTICES};
-use crate::scene::Mesh;
 use glam::Vec3;
+use raytrail_core::scene::Mesh;
 use std::format;
 use std::string::String;
 use std::vec::Vec;

@@ -31,6 +31,8 @@
 //! STL's triangle count, glTF accessors) never size an allocation beyond what the data can hold,
 //! and no input makes a loader panic.
 
+#![warn(missing_docs)]
+
 mod error;
 mod gltf;
 mod obj;
@@ -38,10 +40,10 @@ mod off;
 mod ply;
 mod stl;
 
-pub use error::MeshError;
-
-use crate::scene::Mesh;
 use core::fmt;
+pub use error::MeshError;
+/// The mesh type every loader returns (the core's, so a loaded mesh goes straight to a scene).
+pub use raytrail_core::scene::Mesh;
 use std::io::{self, BufRead, Read, Write};
 use std::path::Path;
 use std::string::{String, ToString};

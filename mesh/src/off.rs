@@ -17,8 +17,8 @@
 //! ([`Source::Face`]).
 
 use super::{show, words, LoadOptions, LoadReport, MeshError, Source, MAX_TRIANGLES, MAX_VERTICES};
-use crate::scene::Mesh;
 use glam::Vec3;
+use raytrail_core::scene::Mesh;
 use std::format;
 use std::string::String;
 use std::vec::Vec;

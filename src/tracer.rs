@@ -1,0 +1,247 @@
+//! [`Tracer`]: a triangle scene ready to trace in one call, with the defaults that suit most rays.
+//!
+//! The tracer owns its tree, so a tree cannot meet the wrong scene. It builds the canonical BVH2
+//! with [`Builder::Best`], collapses it into the 8-wide tree of least node area (Ylitie, Karras &
+//! Laine 2017) and keeps nothing else: every walk it picks from reads that one tree. For a large
+//! batch it times the three walks on a sample of the rays, as `--method auto` does, and traces
+//! the batch with the fastest; a small batch goes ray by ray (what suits rays in no useful
+//! order). A method named with [`TracerBuilder::method`] is used for every batch instead, and the
+//! scene is prepared for it alone.
+
+use crate::analysis::sample::choose_among;
+use crate::{Builder, Error};
+use raytrail_core::method::{Method, Query, WideMethod};
+use raytrail_core::prepared::PreparedScene;
+use raytrail_core::scene::{Mesh, Scene};
+use raytrail_core::trace::{Report, Trace, TraceOptions};
+use raytrail_core::{Hit, Ray};
+use raytrail_cpu::{CpuBackend, CpuScene};
+use std::cell::RefCell;
+use std::sync::Arc;
+
+/// The walks of the 8-wide tree of least node area that the default tracer picks from: single
+/// rays (incoherent rays, small batches), packets (camera rays, shadow rays toward one light),
+/// streams (incoherent closest-hit rays in large batches).
+pub const AUTO_WALKS: [Method; 3] = [
+    Method::Wide(WideMethod::Bvh8Sah),
+    Method::Wide(WideMethod::Bvh8SahPacket),
+    Method::Wide(WideMethod::Bvh8SahStream),
+];
+
+/// Batches of fewer rays are traced with the first of [`AUTO_WALKS`] without timing the others:
+/// a sample of at least 512 rays ([`crate::analysis::sample::sample_size`]), timed about ten times, would cost more than a
+/// third of such a batch.
+pub const AUTO_MIN_RAYS: usize = 1 << 16;
+
+/// How a [`Tracer`] is made: the tree builder, the method, the threads and what to do with rays
+/// that cannot hit anything. Start from [`Tracer::builder`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TracerBuilder {
+    tree: Builder,
+    method: Option<Method>,
+    threads: Option<usize>,
+    reject_untraceable: bool,
+}
+
+impl TracerBuilder {
+    /// The builder of the canonical tree ([`Builder::Best`] unless set).
+    pub fn tree_builder(mut self, builder: Builder) -> Self {
+        self.tree = builder;
+        self
+    }
+
+    /// Traces every batch with `method` (any of [`Method::ALL`]), preparing the scene for it
+    /// alone, instead of picking among [`AUTO_WALKS`].
+    pub fn method(mut self, method: impl Into<Method>) -> Self {
+        self.method = Some(method.into());
+        self
+    }
+
+    /// Traces on a pool of its own of `threads` threads instead of rayon's global pool.
+    pub fn threads(mut self, threads: usize) -> Self {
+        self.threads = Some(threads);
+        self
+    }
+
+    /// Whether a batch holding a ray that cannot hit anything (a NaN or infinite component, a zero
+    /// direction, a NaN bound or `tmin > tmax`) fails with [`Error::UntraceableRays`] before any
+    /// ray is traced. Off by default: such rays are misses, counted in
+    /// [`Report::untraceable`].
+    pub fn reject_untraceable(mut self, reject: bool) -> Self {
+        self.reject_untraceable = reject;
+        self
+    }
+
+    /// A tracer over an indexed mesh held in arrays: `vertices` by position, `triangles` by the
+    /// indices of their vertices; primitive ids are indices into `triangles`.
+    pub fn build(self, vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<Tracer, Error> {
+        self.build_scene(&Scene::from_indexed(vertices, triangles)?)
+    }
+
+    /// A tracer over a loaded mesh ([`crate::load`]).
+    pub fn build_mesh(self, mesh: &Mesh) -> Result<Tracer, Error> {
+        self.build_scene(&mesh.to_scene()?)
+    }
+
+    /// A tracer over a validated scene.
+    pub fn build_scene(self, scene: &Scene) -> Result<Tracer, Error> {
+        let backend = match self.threads {
+            Some(n) => CpuBackend::with_threads(n).map_err(Error::ThreadPool)?,
+            None => CpuBackend::new(),
+        };
+        let bvh = self.tree.build(scene)?;
+        let methods: &[Method] = match &self.method {
+            Some(m) => std::slice::from_ref(m),
+            None => &AUTO_WALKS,
+        };
+        let prepared = backend.prepare(Arc::new(PreparedScene::new(scene, bvh, methods)?))?;
+        Ok(Tracer { backend, scene: prepared, method: self.method, reject_untraceable: self.reject_untraceable })
+    }
+}
+
+/// A triangle scene ready to trace on the CPU: closest hits ([`Tracer::intersect`]) and
+/// occlusion ([`Tracer::occluded`]) of batches or single rays.
+///
+/// ```
+/// use raytrail::{Ray, Tracer, Vec3};
+/// # fn main() -> Result<(), raytrail::Error> {
+/// let tracer = Tracer::new(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]])?;
+/// let hit = tracer.intersect_one(&Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, 0.0, f32::INFINITY))?;
+/// assert_eq!(hit.map(|h| (h.prim, h.t)), Some((0, 1.0)));
+/// # Ok(())
+/// # }
+/// ```
+///
+/// Hits are bit for bit those of every other method and backend (the conformance suite's
+/// contract): `t`, the primitive id (index of the triangle) and the barycentrics `u`, `v` of the
+/// second and third vertex.
+#[derive(Debug)]
+pub struct Tracer {
+    backend: CpuBackend,
+    scene: CpuScene,
+    method: Option<Method>,
+    reject_untraceable: bool,
+}
+
+thread_local! {
+    /// Hit slots for the occlusion calls, which answer with booleans: kept per thread and grown to
+    /// the largest batch seen, so that a renderer's repeated calls allocate once.
+    static SCRATCH: RefCell<Vec<Hit>> = const { RefCell::new(Vec::new()) };
+}
+
+impl Tracer {
+    /// A tracer with the defaults over an indexed mesh held in arrays (see
+    /// [`TracerBuilder::build`]).
+    pub fn new(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<Tracer, Error> {
+        TracerBuilder::default().build(vertices, triangles)
+    }
+
+    /// A tracer with the defaults over a loaded mesh ([`crate::load`]).
+    pub fn from_mesh(mesh: &Mesh) -> Result<Tracer, Error> {
+        TracerBuilder::default().build_mesh(mesh)
+    }
+
+    /// The builder of a tracer with other than the defaults.
+    pub fn builder() -> TracerBuilder {
+        TracerBuilder::default()
+    }
+
+    /// The prepared scene (the tree and the tables its methods read), for the expert API.
+    pub fn prepared(&self) -> &Arc<PreparedScene> {
+        &self.scene.0
+    }
+
+    /// Triangles in the scene.
+    pub fn triangle_count(&self) -> usize {
+        self.scene.0.bvh.prim_order().len()
+    }
+
+    /// The closest hit of each ray ([`Hit::MISS`] where there is none).
+    pub fn intersect(&self, rays: &[Ray]) -> Result<Vec<Hit>, Error> {
+        let mut hits = vec![Hit::MISS; rays.len()];
+        self.intersect_into(rays, &mut hits)?;
+        Ok(hits)
+    }
+
+    /// The closest hit of each ray into `hits` (one slot per ray), allocating nothing but a large
+    /// batch's timing sample; the report counts the untraceable and refused rays.
+    pub fn intersect_into(&self, rays: &[Ray], hits: &mut [Hit]) -> Result<Report, Error> {
+        self.trace(rays, Query::Closest, hits)
+    }
+
+    /// The closest hit of one ray, `None` for a miss (and for a ray that cannot hit anything,
+    /// unless the tracer rejects those).
+    pub fn intersect_one(&self, ray: &Ray) -> Result<Option<Hit>, Error> {
+        let mut hit = [Hit::MISS];
+        self.trace(std::slice::from_ref(ray), Query::Closest, &mut hit)?;
+        one(hit[0])
+    }
+
+    /// Whether anything blocks each ray within its interval.
+    pub fn occluded(&self, rays: &[Ray]) -> Result<Vec<bool>, Error> {
+        let mut out = vec![false; rays.len()];
+        self.occluded_into(rays, &mut out)?;
+        Ok(out)
+    }
+
+    /// Whether anything blocks each ray, into `out` (one slot per ray). The hit slots the
+    /// backend writes are kept per thread, so repeated calls allocate only when a batch is larger
+    /// than any before it on the thread.
+    pub fn occluded_into(&self, rays: &[Ray], out: &mut [bool]) -> Result<Report, Error> {
+        if rays.len() != out.len() {
+            return Err(raytrail_core::Error::BufferMismatch { rays: rays.len(), hits: out.len() }.into());
+        }
+        SCRATCH.with(|scratch| {
+            let mut hits = scratch.borrow_mut();
+            if hits.len() < rays.len() {
+                hits.resize(rays.len(), Hit::MISS);
+            }
+            let hits = &mut hits[..rays.len()];
+            let report = self.trace(rays, Query::Any, hits)?;
+            for (o, h) in out.iter_mut().zip(hits.iter()) {
+                *o = h.is_hit();
+            }
+            Ok(report)
+        })
+    }
+
+    /// Whether anything blocks one ray within its interval.
+    pub fn occluded_one(&self, ray: &Ray) -> Result<bool, Error> {
+        let mut hit = [Hit::MISS];
+        self.trace(std::slice::from_ref(ray), Query::Any, &mut hit)?;
+        Ok(one(hit[0])?.is_some())
+    }
+
+    /// The method this tracer would trace `rays` with for `query`: the one it was built for, or
+    /// the fastest of [`AUTO_WALKS`] on a sample of a batch of at least [`AUTO_MIN_RAYS`] rays.
+    pub fn method_for(&self, rays: &[Ray], query: Query) -> Result<Method, Error> {
+        Ok(match self.method {
+            Some(m) => m,
+            None if rays.len() >= AUTO_MIN_RAYS => {
+                choose_among(&AUTO_WALKS, &self.backend, &self.scene, rays, query)?.method
+            }
+            None => AUTO_WALKS[0],
+        })
+    }
+
+    fn trace(&self, rays: &[Ray], query: Query, hits: &mut [Hit]) -> Result<Report, Error> {
+        raytrail_core::trace::check_buffers(rays, hits)?;
+        if self.reject_untraceable {
+            if let Some(first) = rays.iter().position(|r| !r.is_traceable()) {
+                let count = rays[first..].iter().filter(|r| !r.is_traceable()).count();
+                return Err(Error::UntraceableRays { count, first });
+            }
+        }
+        let method = self.method_for(rays, query)?;
+        Ok(self.backend.trace(&self.scene, rays, &TraceOptions::new(method).query(query), hits)?)
+    }
+}
+
+/// A single ray's answer: `None` for a miss, an error for a refused ray.
+fn one(hit: Hit) -> Result<Option<Hit>, Error> {
+    if hit.is_refused() {
+        Err(Error::RefusedRay)
+    } else {
+        Ok(hit.is_hit().then_some(hit))
+    }
+}
