@@ -40,6 +40,7 @@ publish = false
 [dependencies]
 rc = { path = "$root/core", package = "raytrail-core" }
 rcpu = { path = "$root/backends/cpu", package = "raytrail-cpu" }
+rmesh = { path = "$root/mesh", package = "raytrail-mesh" }
 conf = { path = "$root/conformance", package = "raytrail-conformance" }
 oc = { path = "$old/core", package = "raytrail-core-old" }
 ocpu = { path = "$old/backends/cpu", package = "raytrail-cpu-old" }

@@ -29,7 +29,7 @@
 //! Coincident triangles: PLOC merges only mutual nearest neighbours, and among primitives whose
 //! boxes tie it merges about one pair per pass: 10,000 copies of one triangle took 2.7 s, 30,000
 //! took 22 s, against milliseconds for the SAH builder. Fixed around obvhs, without falling back:
-//! PLOC clusters boxes grown by tiny pseudo-random margins that break the ties ([`ploc_boxes`]);
+//! PLOC clusters boxes grown by tiny pseudo-random margins that break the ties (`ploc_boxes`);
 //! the tree's boxes are recomputed from the triangles as always. Margins cannot separate
 //! triangles collapsed to one point: where more than [`MAX_TIED`] boxes stay identical, the tree is
 //! built by [`SahBuilder`] instead ([`ploc_fallback`] gives the message).
@@ -68,7 +68,7 @@ fn obvhs_params() -> BvhBuildParams {
 /// builder and reinsertion optimizer, with depth at most `max_depth` (values above 63 mean 63).
 ///
 /// Coincident and nearly coincident triangles build in time comparable to well-spread ones: see
-/// [`ploc_boxes`]; more than [`MAX_TIED`] triangles collapsed to one point are built by
+/// `ploc_boxes`; more than [`MAX_TIED`] triangles collapsed to one point are built by
 /// [`SahBuilder`] ([`ploc_fallback`]).
 ///
 /// Where the obvhs tree is deeper than `max_depth`, the offending subtrees are rebuilt with
@@ -146,7 +146,7 @@ fn ploc_boxes(triangles: &[Triangle]) -> Vec<obvhs::aabb::Aabb> {
         .collect()
 }
 
-/// The most triangles whose [`ploc_boxes`] may be identical before [`build_ploc`] falls back to
+/// The most triangles whose `ploc_boxes` may be identical before [`build_ploc`] falls back to
 /// [`SahBuilder`]: margins cannot break ties between triangles collapsed to one point (no margin
 /// at the origin, a few float steps elsewhere), and a tie of `k` boxes costs PLOC about `k`
 /// passes.
@@ -179,13 +179,13 @@ fn fallback_reason(tie: usize) -> Option<String> {
     })
 }
 
-/// Runs obvhs: PLOC (on [`ploc_boxes`]), reinsertion, leaf collapse, reinsertion.
+/// Runs obvhs: PLOC (on `ploc_boxes`), reinsertion, leaf collapse, reinsertion.
 #[cfg(test)]
 fn build_obvhs(triangles: &[Triangle]) -> obvhs::bvh2::Bvh2 {
     build_obvhs_on(ploc_boxes(triangles))
 }
 
-/// Runs obvhs on the boxes of [`ploc_boxes`]: PLOC, reinsertion, leaf collapse, reinsertion.
+/// Runs obvhs on the boxes of `ploc_boxes`: PLOC, reinsertion, leaf collapse, reinsertion.
 fn build_obvhs_on(boxes: Vec<obvhs::aabb::Aabb>) -> obvhs::bvh2::Bvh2 {
     let p = obvhs_params();
     let indices: Vec<u32> = (0..boxes.len() as u32).collect();
@@ -530,7 +530,7 @@ mod tests {
 
     /// Coincident and nearly coincident triangles build within a second (100,000 copies of one
     /// triangle took PLOC over a minute, 30,000 took 22 s, a stack of 30,000 spaced 1e-5 apart 7 s):
-    /// the margins of [`ploc_boxes`] break PLOC's ties.
+    /// the margins of `ploc_boxes` break PLOC's ties.
     #[test]
     fn coincident_and_nearly_coincident_triangles_build_fast() {
         let one = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);

@@ -1,7 +1,7 @@
 //! The library half of the `raytrail` command line: what its tests and other tools share with it.
 //!
 //! - [`npy`]: NumPy ray and hit files, the command line's exchange format.
-//! - [`write`]: writes that never lose a file (a temporary file renamed into place).
+//! - [`write`](mod@write): writes that never lose a file (a temporary file renamed into place).
 #![warn(missing_docs)]
 
 pub mod npy;

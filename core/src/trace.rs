@@ -169,8 +169,16 @@ pub fn trace_framed(
     let framed = scene.frame_rays(rays);
     let mut report = trace(framed.rays(), hits)?;
     report.refused = framed.finish(hits);
-    report.untraceable = rays.iter().filter(|r| !r.is_traceable()).count();
+    report.untraceable = count_untraceable(rays, hits);
     Ok(report)
+}
+
+/// How many of `rays` are untraceable ([`Ray::is_traceable`] false), given their answers `hits`:
+/// only misses are looked at, since an untraceable ray is always one, so a backend can count them
+/// right after tracing a chunk, while its rays are still in cache, for [`Report::untraceable`].
+#[inline]
+pub fn count_untraceable(rays: &[Ray], hits: &[Hit]) -> usize {
+    rays.iter().zip(hits).filter(|(r, h)| !h.is_hit() && !r.is_traceable()).count()
 }
 
 /// A backend: prepares a scene once, then traces batches of rays into hit buffers. Backends are

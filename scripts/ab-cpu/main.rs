@@ -53,7 +53,7 @@ fn main() {
         .unwrap_or((384, 288));
 
     // New side.
-    let mesh = rc::mesh::load(Path::new(path)).unwrap_or_else(|e| die(e.to_string()));
+    let mesh = rmesh::load(Path::new(path)).unwrap_or_else(|e| die(e.to_string()));
     let scene = mesh.to_scene().unwrap_or_else(|e| die(format!("{path}: {e}")));
     let mut cfg = rc::bvh2::SahConfig::default();
     let envf = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f32>().ok());
@@ -81,7 +81,9 @@ fn main() {
         || newb.prepare(Arc::new(rc::prepared::PreparedScene::new(&scene, bvh.clone(), &[m]).unwrap())).unwrap();
     let mut ns = new_side();
     // Old side.
-    let omesh = oc::mesh::load(Path::new(path)).unwrap();
+    // The new side's loader for both: the old commit may keep its loaders in another crate. Both
+    // sides' meshes are positions and index triples of the workspace's glam.
+    let omesh = oc::scene::Mesh { positions: mesh.positions.clone(), triangles: mesh.triangles.clone() };
     let oscene = omesh.to_scene().unwrap();
     let obvh = oc::bvh2::SahBuilder::default().build(oscene.triangles()).unwrap();
     let om = oc::method::Method::from_name(&method)

@@ -8,7 +8,7 @@
 //! - `shaders` (feature `gpu`): the wgpu kernels the choices compile.
 //!
 //! The tables each method builds, and their sizes, come from the core's
-//! [`Part`](raytrail_core::prepared::Part).
+//! `Part` ([`raytrail_core::prepared::Part`]).
 
 pub mod choice;
 pub mod needs;

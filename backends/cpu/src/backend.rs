@@ -4,10 +4,10 @@ use raytrail_core::kd::traverse::packets::PACKET_CHUNK;
 use raytrail_core::method::Method;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
+use raytrail_core::trace::{check_buffers, count_untraceable, Record, Report, Trace, TraceOptions};
 use raytrail_core::wide::STREAM_RAYS;
 use raytrail_core::{Error, Hit, Ray};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -122,6 +122,7 @@ impl CpuBackend {
             let start = Instant::now();
             let out = self.install(|| crate::stream::trace(&scene.0, m, opts, rays, hits))?;
             let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());
+            report.untraceable = count_untraceable(rays, hits);
             report.counters = out.counters.map(|mut c| {
                 c.rays = rays.len() as u64;
                 c
@@ -131,6 +132,7 @@ impl CpuBackend {
             return Ok(Some(report));
         }
         let unframed = AtomicBool::new(false);
+        let untraceable = AtomicUsize::new(0);
         let chunk = chunk_rays(opts.method);
         let mut enumerations: Vec<Vec<u32>> =
             if opts.record == Record::Enumerations { vec![Vec::new(); rays.len()] } else { Vec::new() };
@@ -153,7 +155,11 @@ impl CpuBackend {
                     if unframed.load(Ordering::Relaxed) {
                         return Ok(Counters::default());
                     }
-                    trace_chunk(&scene.0, opts, Chunk { rays, hits, enumerations: e.unwrap_or(&mut []) })
+                    let counters =
+                        trace_chunk(&scene.0, opts, Chunk { rays, hits, enumerations: e.unwrap_or(&mut []) })?;
+                    // Counted here, while the chunk's rays and hits are in cache.
+                    untraceable.fetch_add(count_untraceable(rays, hits), Ordering::Relaxed);
+                    Ok(counters)
                 })
                 .try_reduce(Counters::default, |mut a, b| {
                     a.add(&b);
@@ -165,6 +171,7 @@ impl CpuBackend {
         }
         let seconds = start.elapsed().as_secs_f64();
         let mut report = Report::new(rays.len(), seconds);
+        report.untraceable = untraceable.into_inner();
         report.counters = (opts.record != Record::Nothing).then_some(counters);
         report.enumerations = (opts.record == Record::Enumerations).then_some(enumerations);
         Ok(Some(report))

@@ -4,19 +4,26 @@ use core::fmt;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Bvh2Method {
     /// (a) Stack-based, "while-while" order, closer child first (Aila & Laine 2009).
+    /// Pick it for the binary tree on a CPU: the fastest BVH2 walk there, and every BVH2 method's
+    /// reference.
     Stack,
     /// (a') The stack method pruning postponed nodes by the disjoint t-interval rule: the
-    /// reference that method (e) must enumerate identically.
+    /// reference that method (e) must enumerate identically. Pick it only to check (e).
     StackDisjoint,
     /// (b) Stackless with parent and sibling links and a bit trail (Áfra et al. 2014).
+    /// Pick it where per-ray memory is scarcest and no table fits: backtracking climbs the tree.
     ParentSibling,
-    /// (c) Iterative backtracking over uncle and grand-uncle links, with the register.
+    /// (c) Iterative backtracking over uncle and grand-uncle links, with the register (Binder &
+    /// Keller 2016, Sec. 2.2). Pick it for a stackless walk without hash tables.
     Uncle,
-    /// (d) Constant-time backtracking: register, uncle links, perfect hash (Algorithm 1).
+    /// (d) Constant-time backtracking: register, uncle links, perfect hash (Binder & Keller
+    /// 2016, Algorithm 1). Pick it for GPUs and hardware where a per-ray stack is costly.
     Hash,
-    /// (e) As (d), with the disjoint t-interval mask (Sec. 2.3).
+    /// (e) As (d), with the disjoint t-interval mask (Binder & Keller 2016, Sec. 2.3). Pick it
+    /// over (d) for closest hits in trees whose boxes overlap much.
     HashDisjoint,
-    /// (f) As (d), pausing after every hit and resuming from the node key (Sec. 2.4).
+    /// (f) As (d), pausing after every hit and resuming from the node key (Binder & Keller 2016,
+    /// Sec. 2.4). Pick it where a walk must stop at each hit and go on later (hit filters).
     HashResume,
 }
 

@@ -3,15 +3,18 @@ use core::fmt;
 /// A traversal method of the kd-tree (Horn et al. 2007, Appendix A).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum KdMethod {
-    /// Standard stack traversal (A.1).
+    /// Standard stack traversal (A.1). Pick it for camera rays in architectural scenes on a CPU.
     Stack,
-    /// kd-restart (A.2, after Foley & Sugerman 2005).
+    /// kd-restart (A.2, after Foley & Sugerman 2005). Pick it for no stack at all; it descends
+    /// from the root again for each leaf.
     Restart,
-    /// kd-restart with push-down (A.3).
+    /// kd-restart with push-down (A.3). Pick it over restart: it restarts lower in the tree.
     PushDown,
-    /// Short-stack with push-down, restarting on underflow (A.4).
+    /// Short-stack with push-down, restarting on underflow (A.4). Pick it for a stackless kd walk
+    /// with a few registers to spare: restarts become rare.
     ShortStack,
-    /// Packetized short-stack, packets of four rays of one direction octant (A.5).
+    /// Packetized short-stack, packets of four rays of one direction octant (A.5). Pick it for
+    /// coherent rays on the kd-tree.
     Packet,
 }
 

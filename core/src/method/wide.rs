@@ -7,38 +7,41 @@ use core::fmt;
 /// distance with a sorting network, and any-hit queries push them unsorted (Sec. 4.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum WideMethod {
-    /// Four children per node, by Guthe's pull-up (Sec. 4.1).
+    /// Four children per node, by Guthe's pull-up (Guthe 2014, Sec. 4.1). Pick it for 4-wide
+    /// vector units; on 8-wide ones [`WideMethod::Bvh8`] is faster.
     Bvh4,
-    /// Eight children per node, by the same pull-up (the width of Garanzha & Loop's tree).
+    /// Eight children per node, by the same pull-up (the width of Garanzha & Loop's tree). Pick it
+    /// for any-hit rays one at a time: the largest child comes first.
     Bvh8,
     /// Four children per node by removing every second level of the binary tree: the naive
-    /// collapse the pull-up is measured against.
+    /// collapse the pull-up is measured against (Guthe 2014, Sec. 4.1). Pick it only to measure.
     Bvh4Naive,
     /// Eight children per node, by the cut of least total node area ([`Collapse::Optimal`]):
-    /// fewer nodes per closest-hit ray than the pull-up, more per shadow ray (BENCHMARKS.md,
-    /// "The SAH-optimal 8-wide collapse").
+    /// fewer nodes per closest-hit ray than the pull-up, more per shadow ray (Ylitie, Karras &
+    /// Laine 2017, the collapse). Pick it for closest-hit rays one at a time or in no order.
     Bvh8Sah,
     /// [`WideMethod::Bvh8`]'s tree walked by packets of rays of one octant
     /// ([`crate::wide::packet`]): one node fetch, child order and stack per packet, each ray's own
-    /// box tests and answer. Beyond Guthe's paper; for coherent rays (camera rays, shadow rays to
-    /// one light).
+    /// box tests and answer. Beyond Guthe's paper. Pick it for coherent rays (camera rays, shadow
+    /// rays to one light).
     Bvh8Packet,
     /// [`WideMethod::Bvh8`]'s tree walked by streams of thousands of consecutive rays
     /// ([`crate::wide::ray_stream`]): a node fetched once for every ray of the stream that reaches
     /// it, each ray's own box tests, answer and events, no hand-over to single rays. Beyond both
-    /// papers (Barringer & Akenine-Möller 2014's dynamic ray streams); for incoherent closest-hit
-    /// rays inside a scene (diffuse bounces): any-hit rays gain nothing from it.
+    /// papers (Barringer & Akenine-Möller 2014's dynamic ray streams). Pick it for large batches
+    /// of incoherent closest-hit rays (diffuse bounces); any-hit rays gain nothing from it.
     Bvh8Stream,
     /// [`WideMethod::Bvh4`]'s tree and visiting order without a stack ([`crate::wide::trail`]):
     /// Binder & Keller's node keys, bit trail and perfect hash at two key bits per level, a
-    /// backtrack being one hash lookup and the parent's box tests again. Beyond both papers.
+    /// backtrack being one hash lookup and the parent's box tests again. Beyond both papers. Pick
+    /// it for a wide tree without a per-ray stack (GPUs, hardware).
     Bvh4Hash,
     /// [`WideMethod::Bvh8Sah`]'s tree walked by packets, as [`WideMethod::Bvh8Packet`] walks the
     /// pull-up's: the cut of least node area serves closest-hit packets better and shadow-ray
-    /// packets worse (BENCHMARKS.md, "Packets and streams on the SAH-optimal cut").
+    /// packets worse. Pick it for coherent closest-hit rays (camera rays).
     Bvh8SahPacket,
     /// [`WideMethod::Bvh8Sah`]'s tree walked by ray streams, as [`WideMethod::Bvh8Stream`] walks
-    /// the pull-up's (for incoherent closest-hit rays, as there).
+    /// the pull-up's. Pick it for large batches of incoherent closest-hit rays.
     Bvh8SahStream,
 }
 

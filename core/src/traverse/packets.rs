@@ -1,5 +1,5 @@
 //! How rays are grouped into packets: one convention for every backend and every packet method
-//! (kd packets of [`PACKET_WIDTH`](crate::kd::traverse::PACKET_WIDTH) rays, wide packets of
+//! (kd packets of [`crate::kd::traverse::PACKET_WIDTH`] rays, wide packets of
 //! [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET)), so that a ray shares its packet with the
 //! same rays everywhere and per-ray counters and enumerations agree (a packet's nodes depend on
 //! its rays).

@@ -29,7 +29,7 @@ pub struct WideStats {
 ///
 /// Each leaf starts at a multiple of [`BLOCK`] in the triangle array (the gaps hold NaN triangles
 /// that nothing hits, with primitive id `u32::MAX`), so its triangles are also whole
-/// [`TriangleBlock`]s, `first / BLOCK` onwards, for testing four at once.
+/// [`TriangleBlock`](crate::intersect::TriangleBlock)s, `first / BLOCK` onwards, for testing four at once.
 #[derive(Clone, Debug)]
 pub struct WideBvh<const W: usize> {
     nodes: Vec<WideNode<W>>,

@@ -1,6 +1,6 @@
 //! The lockstep driver: rays in warps of `W` lanes, every unfinished lane making one transition
 //! per cycle, with what each transition was and what it read. The driver is the same for every
-//! structure; what a lane is and how it steps comes from a [`Stepper`](crate::stepper::Stepper).
+//! structure; what a lane is and how it steps comes from a `Stepper` (`stepper.rs`).
 
 use crate::bvh2_lanes::simulate_bvh2;
 use crate::kd_lanes::simulate_kd;

@@ -1,0 +1,167 @@
+//! The high-level API: [`Tracer`] answers as the expert path does, counts or rejects untraceable
+//! rays, and the expert path rejects a tree built for other triangles.
+
+use raytrail::core::method::{Bvh2Method, WideMethod};
+use raytrail::core::prepared::PreparedScene;
+use raytrail::core::scene::Scene;
+use raytrail::core::trace::{Trace, TraceOptions};
+use raytrail::cpu::CpuBackend;
+use raytrail::{Builder, Error, Hit, Method, Query, Ray, Tracer, Vec3, AUTO_MIN_RAYS, AUTO_WALKS};
+use raytrail_conformance::rays::{default_light, primary, scene_epsilon, shadow};
+use raytrail_conformance::suite::generated_scene;
+use std::sync::Arc;
+
+/// The sphereflake as arrays, as a user would hold it: vertices and index triples.
+fn arrays(scene: &Scene) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+    let vertices: Vec<[f32; 3]> = scene.triangles().iter().flat_map(|t| t.v.map(|v| v.to_array())).collect();
+    let triangles = (0..scene.triangles().len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    (vertices, triangles)
+}
+
+/// The stack method's answers, through the expert path.
+fn stack_hits(scene: &Scene, rays: &[Ray], query: Query) -> Vec<Hit> {
+    let method = Method::Bvh2(Bvh2Method::Stack);
+    let prepared = PreparedScene::new(scene, Builder::Sah.build(scene).unwrap(), &[method]).unwrap();
+    let backend = CpuBackend::new();
+    let cpu = backend.prepare(Arc::new(prepared)).unwrap();
+    let mut hits = vec![Hit::MISS; rays.len()];
+    backend.trace(&cpu, rays, &TraceOptions::new(method).query(query), &mut hits).unwrap();
+    hits
+}
+
+#[test]
+fn a_tracer_from_arrays_answers_as_the_stack_method_in_every_form() {
+    let scene = generated_scene("sphereflake").scene;
+    let (vertices, triangles) = arrays(&scene);
+    let tracer = Tracer::new(&vertices, &triangles).unwrap();
+    assert_eq!(tracer.triangle_count(), scene.triangles().len());
+    // Large enough that the tracer times its walks on a sample.
+    let camera = primary(&scene, 320, 240);
+    assert!(camera.len() >= AUTO_MIN_RAYS);
+    let want = stack_hits(&scene, &camera, Query::Closest);
+    let got = tracer.intersect(&camera).unwrap();
+    assert!(got.iter().zip(&want).all(|(a, b)| a.same_as(b)), "batch hits differ from the stack method's");
+    assert!(got.iter().any(Hit::is_hit) && got.iter().any(|h| !h.is_hit()));
+    assert!(AUTO_WALKS.contains(&tracer.method_for(&camera, Query::Closest).unwrap()));
+    // Slice in, slice out.
+    let mut into = vec![Hit::MISS; camera.len()];
+    let report = tracer.intersect_into(&camera, &mut into).unwrap();
+    assert_eq!((report.rays, report.untraceable, report.refused), (camera.len(), 0, 0));
+    assert!(into.iter().zip(&want).all(|(a, b)| a.same_as(b)));
+    // One ray at a time, hits and misses.
+    for (ray, want) in camera.iter().zip(&want).step_by(997) {
+        let one = tracer.intersect_one(ray).unwrap();
+        assert_eq!(one.map(|h| (h.prim, h.t.to_bits())), want.is_hit().then_some((want.prim, want.t.to_bits())));
+    }
+    // Occlusion: shadow rays toward a light, against the stack method's any-hit answers.
+    let b = scene.bounds();
+    let shadows = shadow(&camera, &want, default_light(b), scene_epsilon(b));
+    let want_any = stack_hits(&scene, &shadows, Query::Any);
+    let blocked = tracer.occluded(&shadows).unwrap();
+    assert!(blocked.iter().zip(&want_any).all(|(&o, h)| o == h.is_hit()), "occlusion differs");
+    assert!(blocked.iter().any(|&o| o) && blocked.iter().any(|&o| !o));
+    let mut again = vec![true; shadows.len()];
+    tracer.occluded_into(&shadows, &mut again).unwrap();
+    assert_eq!(again, blocked);
+    for (ray, &o) in shadows.iter().zip(&blocked).step_by(101) {
+        assert_eq!(tracer.occluded_one(ray).unwrap(), o);
+    }
+}
+
+#[test]
+fn a_named_method_and_thread_count_are_used_for_every_batch() {
+    let scene = generated_scene("sphereflake").scene;
+    let rays = primary(&scene, 64, 48);
+    let method = Method::Wide(WideMethod::Bvh4Hash);
+    let tracer = Tracer::builder().method(method).threads(1).tree_builder(Builder::Sah).build_scene(&scene).unwrap();
+    assert_eq!(tracer.method_for(&rays, Query::Closest).unwrap(), method);
+    // Only that method's tables were built.
+    assert!(tracer.prepared().check_prepared(method).is_ok());
+    assert!(tracer.prepared().check_prepared(Method::Wide(WideMethod::Bvh8)).is_err());
+    let want = stack_hits(&scene, &rays, Query::Closest);
+    assert!(tracer.intersect(&rays).unwrap().iter().zip(&want).all(|(a, b)| a.same_as(b)));
+}
+
+#[test]
+fn untraceable_rays_are_counted_or_rejected() {
+    let tri = Tracer::new(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]]).unwrap();
+    let good = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, 0.0, f32::INFINITY);
+    let bad = [
+        Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::ZERO, 0.0, f32::INFINITY),
+        Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(f32::NAN, 0.0, -1.0), 0.0, f32::INFINITY),
+        Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, 2.0, 1.0),
+    ];
+    let rays = [good, bad[0], good, bad[1], bad[2]];
+    let mut hits = [Hit::MISS; 5];
+    let report = tri.intersect_into(&rays, &mut hits).unwrap();
+    assert_eq!(report.untraceable, 3);
+    assert_eq!(hits.map(|h| h.is_hit()), [true, false, true, false, false]);
+    for b in &bad {
+        assert_eq!(tri.intersect_one(b).unwrap(), None);
+        assert!(!tri.occluded_one(b).unwrap());
+    }
+    let strict = Tracer::builder()
+        .reject_untraceable(true)
+        .build(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]])
+        .unwrap();
+    match strict.intersect(&rays) {
+        Err(Error::UntraceableRays { count: 3, first: 1 }) => {}
+        other => panic!("expected UntraceableRays {{ count: 3, first: 1 }}, got {other:?}"),
+    }
+    assert!(matches!(strict.occluded_one(&bad[2]), Err(Error::UntraceableRays { count: 1, first: 0 })));
+    assert!(strict.intersect_one(&good).unwrap().is_some());
+}
+
+#[test]
+fn bad_input_is_a_typed_error() {
+    let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let index_past_the_vertices = Tracer::new(&v, &[[0, 1, 3]]).unwrap_err();
+    assert!(matches!(
+        index_past_the_vertices,
+        Error::Core(raytrail::core::Error::VertexIndexOutOfRange { triangle: 0, index: 3, vertex_count: 3 })
+    ));
+    assert!(matches!(Tracer::new(&v, &[]), Err(Error::Core(raytrail::core::Error::EmptyScene))));
+    let nan = [[0.0, 0.0, 0.0], [1.0, f32::NAN, 0.0], [0.0, 1.0, 0.0]];
+    assert!(matches!(
+        Tracer::new(&nan, &[[0, 1, 2]]),
+        Err(Error::Core(raytrail::core::Error::NonFiniteVertex { vertex: 1 }))
+    ));
+    let tracer = Tracer::new(&v, &[[0, 1, 2]]).unwrap();
+    let rays = [Ray::new(Vec3::ONE, -Vec3::Z, 0.0, 1.0); 2];
+    let mismatch = tracer.intersect_into(&rays, &mut [Hit::MISS; 3]).unwrap_err();
+    assert!(matches!(mismatch, Error::Core(raytrail::core::Error::BufferMismatch { rays: 2, hits: 3 })));
+    assert!(matches!(
+        tracer.occluded_into(&rays, &mut [false; 1]),
+        Err(Error::Core(raytrail::core::Error::BufferMismatch { .. }))
+    ));
+    // Errors are std errors with a cause and a one-line message naming the problem.
+    let e: &dyn std::error::Error = &index_past_the_vertices;
+    assert!(e.source().is_some());
+    assert!(e.to_string().contains("vertex 3"), "{e}");
+}
+
+#[test]
+fn a_tree_built_for_other_triangles_is_rejected() {
+    let scene = generated_scene("sphereflake").scene;
+    let bvh = Builder::Sah.build(&scene).unwrap();
+    // The same triangle count, one triangle moved by 10 units.
+    let mut moved = scene.triangles().to_vec();
+    for v in &mut moved[17].v {
+        *v += Vec3::splat(10.0);
+    }
+    let moved = Scene::new(moved).unwrap();
+    for method in [Method::Bvh2(Bvh2Method::Stack), Method::Wide(WideMethod::Bvh8)] {
+        match PreparedScene::new(&moved, bvh.clone(), &[method]) {
+            Err(raytrail::core::Error::TreeMismatch { .. }) => {}
+            other => panic!("{method}: expected TreeMismatch, got {:?}", other.map(|_| "a prepared scene")),
+        }
+    }
+    // Fewer triangles: also a mismatch, not a panic.
+    let fewer = Scene::new(scene.triangles()[..100].to_vec()).unwrap();
+    assert!(matches!(
+        PreparedScene::new(&fewer, bvh.clone(), &[Method::Bvh2(Bvh2Method::Stack)]),
+        Err(raytrail::core::Error::TreeMismatch { .. })
+    ));
+    // Its own tree passes.
+    assert!(PreparedScene::new(&scene, bvh, &[Method::Bvh2(Bvh2Method::Stack)]).is_ok());
+}
