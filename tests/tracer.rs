@@ -165,3 +165,29 @@ fn a_tree_built_for_other_triangles_is_rejected() {
     // Its own tree passes.
     assert!(PreparedScene::new(&scene, bvh, &[Method::Bvh2(Bvh2Method::Stack)]).is_ok());
 }
+
+#[test]
+fn the_chunk_check_frames_as_needs_framing_and_counts_as_is_traceable() {
+    let scene = generated_scene("sphereflake").scene;
+    let prepared =
+        PreparedScene::new(&scene, Builder::Sah.build(&scene).unwrap(), &[Method::Bvh2(Bvh2Method::Stack)]).unwrap();
+    let mut rays = raytrail_conformance::rays::adversarial(&scene, 7);
+    rays.extend(primary(&scene, 16, 16));
+    let untraceable = rays.iter().filter(|r| !r.is_traceable()).count();
+    assert!(untraceable > 0, "the adversarial set holds untraceable rays");
+    let (mut framed, mut counted) = (0, 0);
+    for chunk in rays.chunks(37) {
+        let check = prepared.check_rays(chunk);
+        assert_eq!(check.needs_framing, prepared.needs_framing(chunk));
+        framed += usize::from(check.needs_framing);
+        counted += check.untraceable;
+    }
+    assert_eq!(counted, untraceable);
+    assert!(framed > 0, "some adversarial chunks need framing");
+    // And the CPU backend's report counts them, framed or not.
+    let backend = CpuBackend::new();
+    let cpu = backend.prepare(Arc::new(prepared)).unwrap();
+    let mut hits = vec![Hit::MISS; rays.len()];
+    let report = backend.trace(&cpu, &rays, &TraceOptions::new(Bvh2Method::Stack), &mut hits).unwrap();
+    assert_eq!(report.untraceable, untraceable);
+}

@@ -35,10 +35,10 @@ pub fn main(a: StressArgs) -> Outcome {
     let mut progress = Progress::new("stress cases", cases.len() * backends);
     let mut results: Vec<(String, &'static str, Vec<Tally>)> = Vec::new();
     for case in &cases {
-        results.push((case.name.clone(), "cpu", run_case(&cpu, case).map_err(Failure::Run)?));
+        results.push((case.name.clone(), "cpu", run_case(&cpu, case).map_err(|e| Failure::Run(e.to_string()))?));
         progress.step(&format!("{} on the CPU", case.name));
         if let Some(g) = &gpu {
-            results.push((case.name.clone(), "wgpu", run_case(g, case).map_err(Failure::Run)?));
+            results.push((case.name.clone(), "wgpu", run_case(g, case).map_err(|e| Failure::Run(e.to_string()))?));
             progress.step(&format!("{} on the GPU", case.name));
         }
     }

@@ -29,6 +29,16 @@ pub enum Difference {
         /// The ray's enumeration: its packet, then the packet's leaves.
         got: Vec<u32>,
     },
+    /// The batch's report counts the untraceable or the refused rays otherwise than its rays and
+    /// hits say (a whole-batch difference, reported at ray 0).
+    Count {
+        /// What is counted: `untraceable` or `refused`.
+        what: &'static str,
+        /// The rays that are so.
+        expected: usize,
+        /// The report's count.
+        got: usize,
+    },
     /// Node enumerations differ.
     Enumeration {
         /// The reference's visited nodes (canonical ids).
@@ -111,6 +121,9 @@ impl fmt::Display for Mismatch {
                 writeln!(f, "    got      hit {got:?} (t bits {:#010x})", got.t.to_bits())
             }
             Difference::Occlusion { expected, got } => writeln!(f, "    expected occluded={expected}, got {got}"),
+            Difference::Count { what, expected, got } => {
+                writeln!(f, "    the batch has {expected} {what} rays, the report counts {got}")
+            }
             Difference::IncompleteLeafList { leaf, got } => {
                 writeln!(f, "    the reference hit is in leaf {leaf}, which the packet's leaf list lacks:")?;
                 write_seq(f, self.method.name(), got, 0)
@@ -136,6 +149,8 @@ pub struct Outcome {
     pub hits: Vec<Hit>,
     /// Enumerations per ray.
     pub enumerations: Vec<Vec<u32>>,
+    /// The report's counts of untraceable and of refused rays.
+    pub counts: [usize; 2],
 }
 
 /// Traces `rays` with every method in `methods` for `query`, recording enumerations.
@@ -154,7 +169,8 @@ pub fn trace_all<B: Trace>(
             let report = backend.trace(scene, rays, &opts, &mut hits)?;
             // A backend that recorded none is caught by `compare_backends`, which goes by the
             // reference's enumerations.
-            Ok(Outcome { method, query, hits, enumerations: report.enumerations.unwrap_or_default() })
+            let counts = [report.untraceable, report.refused];
+            Ok(Outcome { method, query, hits, enumerations: report.enumerations.unwrap_or_default(), counts })
         })
         .collect()
 }
@@ -251,6 +267,14 @@ pub fn compare_backends(ctx: Context<'_>, rays: &[Ray], cpu: &[Outcome], other: 
                         Query::Any => Difference::Occlusion { expected: e.is_hit(), got: g.is_hit() },
                     },
                 );
+            }
+        }
+        // The counts against the rays and hits themselves: every backend counts alike.
+        let truth =
+            [rays.iter().filter(|r| !r.is_traceable()).count(), o.hits.iter().filter(|h| h.is_refused()).count()];
+        for ((what, expected), got) in ["untraceable", "refused"].into_iter().zip(truth).zip(o.counts) {
+            if !rays.is_empty() && expected != got {
+                push(0, Difference::Count { what, expected, got });
             }
         }
         // Indexed by the reference's enumerations, so a backend that recorded none (or too few)
@@ -366,11 +390,36 @@ mod tests {
             query: Query::Closest,
             hits: vec![Hit::MISS],
             enumerations,
+            counts: [0, 0],
         };
         let ctx = Context { scene: "s", ray_set: "r", backend: "b" };
         let found = compare_backends(ctx, &rays, &[outcome(vec![vec![1, 2]])], &[outcome(Vec::new())]);
         assert_eq!(found.len(), 1);
         assert_eq!(found[0].difference, Difference::Enumeration { expected: vec![1, 2], got: Vec::new() });
+    }
+    #[test]
+    fn a_report_that_miscounts_untraceable_or_refused_rays_mismatches() {
+        let good = Ray::new(glam::Vec3::ZERO, glam::Vec3::X, 0.0, 1.0);
+        let zero_direction = Ray::new(glam::Vec3::ZERO, glam::Vec3::ZERO, 0.0, 1.0);
+        let rays = [good, zero_direction];
+        let outcome = |hits: Vec<Hit>, counts: [usize; 2]| Outcome {
+            method: Method::Bvh2(Bvh2Method::Stack),
+            query: Query::Closest,
+            hits,
+            enumerations: Vec::new(),
+            counts,
+        };
+        let ctx = Context { scene: "s", ray_set: "r", backend: "b" };
+        let cpu = [outcome(vec![Hit::MISS; 2], [1, 0])];
+        assert!(compare_backends(ctx, &rays, &cpu, &[outcome(vec![Hit::MISS; 2], [1, 0])]).is_empty());
+        let uncounted = compare_backends(ctx, &rays, &cpu, &[outcome(vec![Hit::MISS; 2], [0, 0])]);
+        assert_eq!(uncounted[0].difference, Difference::Count { what: "untraceable", expected: 1, got: 0 });
+        let refused = [Hit::MISS, Hit::REFUSED];
+        let cpu = [outcome(refused.to_vec(), [1, 1])];
+        let miscounted = compare_backends(ctx, &rays, &cpu, &[outcome(refused.to_vec(), [1, 0])]);
+        assert_eq!(miscounted.len(), 1);
+        assert_eq!(miscounted[0].difference, Difference::Count { what: "refused", expected: 1, got: 0 });
+        assert!(miscounted[0].to_string().contains("1 refused rays, the report counts 0"));
     }
 
     #[test]

@@ -169,16 +169,15 @@ pub fn trace_framed(
     let framed = scene.frame_rays(rays);
     let mut report = trace(framed.rays(), hits)?;
     report.refused = framed.finish(hits);
-    report.untraceable = count_untraceable(rays, hits);
+    report.untraceable = count_untraceable(rays);
     Ok(report)
 }
 
-/// How many of `rays` are untraceable ([`Ray::is_traceable`] false), given their answers `hits`:
-/// only misses are looked at, since an untraceable ray is always one, so a backend can count them
-/// right after tracing a chunk, while its rays are still in cache, for [`Report::untraceable`].
+/// How many of `rays` are untraceable ([`Ray::is_traceable`] false), for [`Report::untraceable`]
+/// ([`Ray::untraceable_flag`], no branch per ray).
 #[inline]
-pub fn count_untraceable(rays: &[Ray], hits: &[Hit]) -> usize {
-    rays.iter().zip(hits).filter(|(r, h)| !h.is_hit() && !r.is_traceable()).count()
+pub fn count_untraceable(rays: &[Ray]) -> usize {
+    rays.iter().map(|r| r.untraceable_flag() as usize).sum()
 }
 
 /// A backend: prepares a scene once, then traces batches of rays into hit buffers. Backends are
@@ -201,4 +200,29 @@ pub trait Trace: Send + Sync {
         options: &TraceOptions,
         hits: &mut [Hit],
     ) -> Result<Report, Error>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn the_untraceable_count_agrees_with_is_traceable_on_every_kind_of_bad_ray() {
+        let values = [0.0, -0.0, 1.0, -2.5, 1e-40, f32::MAX, f32::INFINITY, f32::NEG_INFINITY, f32::NAN];
+        let mut rays = Vec::new();
+        for &a in &values {
+            for &b in &values {
+                rays.push(Ray::new(Vec3::new(a, 1.0, 2.0), Vec3::new(b, 0.0, 0.0), 0.0, f32::INFINITY));
+                rays.push(Ray::new(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, a, b), 0.0, 1.0));
+                rays.push(Ray::new(Vec3::ONE, Vec3::Z, a, b));
+            }
+        }
+        for r in &rays {
+            assert_eq!(r.untraceable_flag() == 0, r.is_traceable(), "{r:?}");
+        }
+        let expected = rays.iter().filter(|r| !r.is_traceable()).count();
+        assert!(expected > 0 && expected < rays.len());
+        assert_eq!(count_untraceable(&rays), expected);
+    }
 }

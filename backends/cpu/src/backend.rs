@@ -4,7 +4,7 @@ use raytrail_core::kd::traverse::packets::PACKET_CHUNK;
 use raytrail_core::method::Method;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::trace::{check_buffers, count_untraceable, Record, Report, Trace, TraceOptions};
+use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
 use raytrail_core::wide::STREAM_RAYS;
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -114,15 +114,24 @@ impl CpuBackend {
         scene.0.check_prepared(opts.method)?;
         if let Method::Stream(m) = opts.method {
             // The batch as a whole: its stages are the parallel part.
-            if framing == Framing::Check
-                && self.install(|| rays.par_chunks(PACKET_CHUNK).any(|c| scene.0.needs_framing(c)))
-            {
-                return Ok(None);
+            let mut untraceable = 0;
+            if framing == Framing::Check {
+                let (needs_framing, n) = self.install(|| {
+                    rays.par_chunks(PACKET_CHUNK)
+                        .map(|c| scene.0.check_rays(c))
+                        .fold(|| (false, 0), |(f, n), c| (f | c.needs_framing, n + c.untraceable))
+                        .reduce(|| (false, 0), |a, b| (a.0 | b.0, a.1 + b.1))
+                });
+                if needs_framing {
+                    return Ok(None);
+                }
+                untraceable = n;
             }
             let start = Instant::now();
             let out = self.install(|| crate::stream::trace(&scene.0, m, opts, rays, hits))?;
             let mut report = Report::new(rays.len(), start.elapsed().as_secs_f64());
-            report.untraceable = count_untraceable(rays, hits);
+            // Framed rays are counted by `trace_framed`, which has the caller's.
+            report.untraceable = untraceable;
             report.counters = out.counters.map(|mut c| {
                 c.rays = rays.len() as u64;
                 c
@@ -149,17 +158,17 @@ impl CpuBackend {
                 .zip(hits.par_chunks_mut(chunk))
                 .zip(enum_chunks.into_par_iter())
                 .map(|((rays, hits), e)| {
-                    if framing == Framing::Check && scene.0.needs_framing(rays) {
-                        unframed.store(true, Ordering::Relaxed);
+                    if framing == Framing::Check {
+                        let check = scene.0.check_rays(rays);
+                        if check.needs_framing {
+                            unframed.store(true, Ordering::Relaxed);
+                        }
+                        untraceable.fetch_add(check.untraceable, Ordering::Relaxed);
                     }
                     if unframed.load(Ordering::Relaxed) {
                         return Ok(Counters::default());
                     }
-                    let counters =
-                        trace_chunk(&scene.0, opts, Chunk { rays, hits, enumerations: e.unwrap_or(&mut []) })?;
-                    // Counted here, while the chunk's rays and hits are in cache.
-                    untraceable.fetch_add(count_untraceable(rays, hits), Ordering::Relaxed);
-                    Ok(counters)
+                    trace_chunk(&scene.0, opts, Chunk { rays, hits, enumerations: e.unwrap_or(&mut []) })
                 })
                 .try_reduce(Counters::default, |mut a, b| {
                     a.add(&b);
@@ -171,6 +180,7 @@ impl CpuBackend {
         }
         let seconds = start.elapsed().as_secs_f64();
         let mut report = Report::new(rays.len(), seconds);
+        // Framed rays are counted by `trace_framed`, which has the caller's.
         report.untraceable = untraceable.into_inner();
         report.counters = (opts.record != Record::Nothing).then_some(counters);
         report.enumerations = (opts.record == Record::Enumerations).then_some(enumerations);

@@ -11,7 +11,7 @@ pub mod cases;
 pub mod run;
 
 pub use cases::{all_cases, case_names, StressCase};
-pub use run::{run_case, Tally};
+pub use run::{run_case, CaseError, Tally};
 
 /// Defines one `#[test]` per stress case for a backend (as `conformance_suite!` does, `try` for a
 /// constructor returning a `Result`; a missing GPU adapter skips unless `RAYTRAIL_REQUIRE_GPU=1`).

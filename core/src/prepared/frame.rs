@@ -60,6 +60,15 @@ pub struct FramedRays<'a> {
     fixes: Vec<Fix>,
 }
 
+/// What [`PreparedScene::check_rays`] finds in a chunk of rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RayCheck {
+    /// Whether [`PreparedScene::frame_rays`] would change any of them.
+    pub needs_framing: bool,
+    /// How many are untraceable ([`Ray::is_traceable`] false).
+    pub untraceable: usize,
+}
+
 /// A ray that every method answers as a miss without visiting a node.
 const NOTHING: Ray = Ray { origin: [0.0; 3], tmin: 1.0, dir: [0.0, 0.0, 1.0], tmax: 0.0 };
 
@@ -162,6 +171,14 @@ fn surely_kept(ray: &Ray, far: f32, min_dir: f32) -> bool {
     let near = |i: usize| ray.origin[i].abs() <= far;
     let sized = |i: usize| ray.dir[i].abs() > min_dir;
     near(0) & near(1) & near(2) & (sized(0) | sized(1) | sized(2))
+}
+
+/// Whether a ray that [`surely_kept`] clears is traceable ([`Ray::is_traceable`]): such a ray has
+/// a finite origin and a non-zero direction already, so a finite direction and `tmin <= tmax` are
+/// what is left. Comparisons only, no branch, for the clearing fold.
+#[inline(always)]
+fn plainly_traceable(ray: &Ray) -> bool {
+    (ray.dir[0] * 0.0 + ray.dir[1] * 0.0 + ray.dir[2] * 0.0 == 0.0) & (ray.tmin <= ray.tmax)
 }
 
 /// The direction size above which a ray whose origin is within `far` of a scene of magnitude
@@ -270,6 +287,22 @@ impl PreparedScene {
         // Without a branch per ray (the compiler vectorizes it), then exactly where that fails.
         let cleared = frame.k == 0 && rays.iter().fold(true, |all, r| all & surely_kept(r, frame.far, frame.min_dir));
         !cleared && !rays.iter().all(|r| frame.keeps(r))
+    }
+
+    /// One pass over `rays` that says what [`PreparedScene::needs_framing`] says and counts the
+    /// untraceable rays ([`Ray::untraceable_flag`]) in the same loop, for a backend that checks
+    /// each chunk before tracing it: the count rides on the loads the check makes anyway.
+    pub fn check_rays(&self, rays: &[Ray]) -> RayCheck {
+        let frame = self.frame();
+        // The usual chunk: every ray surely kept and plainly traceable, decided by one fold without
+        // a branch per ray, as in `needs_framing`: nothing to frame, nothing untraceable. Anything
+        // else is decided exactly, ray by ray.
+        let clean = frame.k == 0
+            && rays.iter().fold(true, |all, r| all & surely_kept(r, frame.far, frame.min_dir) & plainly_traceable(r));
+        if clean {
+            return RayCheck { needs_framing: false, untraceable: 0 };
+        }
+        RayCheck { needs_framing: self.needs_framing(rays), untraceable: crate::trace::count_untraceable(rays) }
     }
 
     /// The batch `rays` in this scene's frame (see the module docs); borrows the rays where none

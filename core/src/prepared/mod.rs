@@ -6,7 +6,7 @@ mod frame;
 pub mod normalize;
 mod parts;
 
-pub use frame::{FramedRays, FAR_FACTOR, FAR_LIMIT};
+pub use frame::{FramedRays, RayCheck, FAR_FACTOR, FAR_LIMIT};
 pub use parts::Part;
 
 use crate::bvh2::traverse::TraceRoot;

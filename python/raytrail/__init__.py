@@ -1,0 +1,33 @@
+"""raytrail: ray traversal for triangle meshes, NumPy rays in, hits out.
+
+>>> import numpy as np, raytrail
+>>> scene = raytrail.Scene([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+>>> hits = scene.intersect([[0.25, 0.25, 1.0]], [[0.0, 0.0, -1.0]])
+>>> hits.prim.tolist(), hits.t.tolist()
+([0], [1.0])
+
+- :class:`Scene` builds the tree once from vertices and faces (:func:`load` from a mesh file);
+  :meth:`Scene.intersect` returns :class:`Hits` ``(t, prim, u, v)``, :meth:`Scene.occluded` a
+  bool per ray. Both release the GIL and trace on all cores.
+- :mod:`raytrail.trimesh`: ``RayMeshIntersector``, a drop-in for ``mesh.ray`` in trimesh.
+- :mod:`raytrail.dask`: ``intersect`` / ``occluded`` over dask arrays chunked by rows, on
+  dask.distributed or any other scheduler.
+
+A miss has ``prim == -1`` and ``t == inf``; :data:`REFUSED` (-2) marks a ray too far from the
+scene to answer exactly (``t`` NaN). See the package README for the conventions in full.
+"""
+
+from ._raytrail import METHODS, REFUSED, Scene, __version__, load
+from ._hits import Hits
+
+__all__ = ["Scene", "Hits", "load", "METHODS", "REFUSED", "__version__", "trimesh", "dask"]
+
+
+def __getattr__(name):
+    # The trimesh and dask layers import their (optional) libraries, so they load on first use:
+    # `import raytrail` needs only NumPy, and `raytrail.trimesh` works without an explicit import.
+    if name in ("trimesh", "dask"):
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
