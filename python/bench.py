@@ -34,7 +34,10 @@ import time
 
 import numpy as np
 
-import raytrail
+# The installed package, not the source folder beside this script (which lacks the native module).
+_HERE = pathlib.Path(__file__).resolve().parent
+sys.path[:] = [p for p in sys.path if pathlib.Path(p or ".").resolve() != _HERE]
+import raytrail  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 

@@ -24,9 +24,10 @@ pub enum Error {
         /// The index of the first.
         first: usize,
     },
-    /// The ray lies outside the numeric range every method answers exactly (a coordinate beyond
-    /// about `1e18` times the scene's size), so it was refused rather than answered wrongly; a
-    /// batch answers such rays with [`Hit::REFUSED`](raytrail_core::Hit::REFUSED) instead.
+    /// The ray lies outside the numeric range every method answers exactly (an origin farther
+    /// than [`FAR_LIMIT`](raytrail_core::prepared::FAR_LIMIT), 2^32, times the scene's size, or
+    /// a direction too short to trace reliably), so it was refused rather than answered wrongly;
+    /// a batch answers such rays with [`Hit::REFUSED`](raytrail_core::Hit::REFUSED) instead.
     RefusedRay,
     /// A thread pool for [`crate::TracerBuilder::threads`] could not be made.
     #[cfg(feature = "cpu")]

@@ -1,51 +1,7 @@
 """Type stubs of the raytrail package (the native Scene and load, and the pure-Python parts)."""
 
-import os
-from typing import Optional, Tuple, Union
-
-import numpy as np
-import numpy.typing as npt
-
 from ._hits import Hits as Hits
 from . import dask as dask, trimesh as trimesh
 
-__version__: str
-#: "auto" and every method name the tracer knows (Scene.intersect's `method`).
-METHODS: Tuple[str, ...]
-#: `prim` of a ray too far from the scene to answer exactly (its `t` is NaN); a miss is -1.
-REFUSED: int
-
-_Bound = Union[float, npt.ArrayLike, None]
-
-class Scene:
-    """A triangle mesh ready to trace (the tree built once); pickles as its vertices and faces."""
-
-    def __init__(self, vertices: npt.ArrayLike, faces: npt.ArrayLike, *, threads: Optional[int] = None) -> None: ...
-    def intersect(
-        self,
-        origins: npt.ArrayLike,
-        directions: Optional[npt.ArrayLike] = None,
-        tmin: _Bound = None,
-        tmax: _Bound = None,
-        method: str = "auto",
-    ) -> Hits:
-        """Closest hits: Hits(t float32, prim int64 (-1 miss), u float32, v float32)."""
-    def occluded(
-        self,
-        origins: npt.ArrayLike,
-        directions: Optional[npt.ArrayLike] = None,
-        tmin: _Bound = None,
-        tmax: _Bound = None,
-        method: str = "auto",
-    ) -> npt.NDArray[np.bool_]:
-        """Whether anything blocks each ray within [tmin, tmax]."""
-    @property
-    def vertices(self) -> npt.NDArray[np.float32]: ...
-    @property
-    def faces(self) -> npt.NDArray[np.int64]: ...
-    @property
-    def threads(self) -> Optional[int]: ...
-    def __len__(self) -> int: ...
-
-def load(path: Union[str, "os.PathLike[str]"], *, threads: Optional[int] = None) -> Scene:
-    """A Scene from an OBJ, PLY, OFF, STL or glTF file (gzipped or not)."""
+# The native module's names, described once in _raytrail.pyi.
+from ._raytrail import METHODS as METHODS, REFUSED as REFUSED, Scene as Scene, __version__ as __version__, load as load

@@ -566,9 +566,7 @@ fn faces_from(obj: &Bound<'_, PyAny>, vertex_count: usize) -> PyResult<Vec<[u32;
     if !matches!(a.shape(), [_, 3]) {
         return Err(value_error(format!("faces: expected shape (M, 3), got {}", shape_str(a.shape()))));
     }
-    let bad = |i: usize, j: usize, idx: String, why: &str| value_error(format!("faces[{i}, {j}] = {idx}: {why}"));
-    let past = format!("past the {vertex_count} vertices (indices run from 0 to {})", vertex_count.saturating_sub(1));
-    let mut out = Vec::with_capacity(a.shape()[0]);
+    // Either integer kind is read as its 64-bit form, then each index checked against the vertices.
     match dt.kind() {
         b'i' => {
             let a = if dt.is_equiv_to(&dtype::<i64>(py)) {
@@ -578,19 +576,7 @@ fn faces_from(obj: &Bound<'_, PyAny>, vertex_count: usize) -> PyResult<Vec<[u32;
             };
             let ro = borrow::<i64>(&a, "faces")?;
             let v = ro.as_array().into_dimensionality::<Ix2>().expect("checked: two dimensions");
-            for (i, row) in v.outer_iter().enumerate() {
-                let mut f = [0u32; 3];
-                for (j, (&idx, slot)) in row.iter().zip(&mut f).enumerate() {
-                    if idx < 0 {
-                        return Err(bad(i, j, idx.to_string(), "negative vertex index"));
-                    }
-                    if idx as u64 >= vertex_count as u64 {
-                        return Err(bad(i, j, idx.to_string(), &past));
-                    }
-                    *slot = idx as u32;
-                }
-                out.push(f);
-            }
+            face_rows(v, |idx| if idx < 0 { Err("negative vertex index") } else { Ok(idx as u64) }, vertex_count)
         }
         b'u' => {
             let a = if dt.is_equiv_to(&dtype::<u64>(py)) {
@@ -600,22 +586,32 @@ fn faces_from(obj: &Bound<'_, PyAny>, vertex_count: usize) -> PyResult<Vec<[u32;
             };
             let ro = borrow::<u64>(&a, "faces")?;
             let v = ro.as_array().into_dimensionality::<Ix2>().expect("checked: two dimensions");
-            for (i, row) in v.outer_iter().enumerate() {
-                let mut f = [0u32; 3];
-                for (j, (&idx, slot)) in row.iter().zip(&mut f).enumerate() {
-                    if idx >= vertex_count as u64 {
-                        return Err(bad(i, j, idx.to_string(), &past));
-                    }
-                    *slot = idx as u32;
-                }
-                out.push(f);
+            face_rows(v, Ok, vertex_count)
+        }
+        _ => Err(PyTypeError::new_err(format!("faces: expected an integer dtype (vertex indices), got dtype {dt}"))),
+    }
+}
+
+/// The faces of an (M, 3) index array as `u32` triples: `index` turns an entry into an unsigned
+/// index or says why it is none; an index must name one of the `vertex_count` vertices.
+fn face_rows<T: Copy + std::fmt::Display>(
+    v: ArrayView2<'_, T>,
+    index: impl Fn(T) -> Result<u64, &'static str>,
+    vertex_count: usize,
+) -> PyResult<Vec<[u32; 3]>> {
+    let bad = |i: usize, j: usize, idx: T, why: &str| value_error(format!("faces[{i}, {j}] = {idx}: {why}"));
+    let past = format!("past the {vertex_count} vertices (indices run from 0 to {})", vertex_count.saturating_sub(1));
+    let mut out = Vec::with_capacity(v.nrows());
+    for (i, row) in v.outer_iter().enumerate() {
+        let mut f = [0u32; 3];
+        for (j, (&idx, slot)) in row.iter().zip(&mut f).enumerate() {
+            let u = index(idx).map_err(|why| bad(i, j, idx, why))?;
+            if u >= vertex_count as u64 {
+                return Err(bad(i, j, idx, &past));
             }
+            *slot = u as u32;
         }
-        _ => {
-            return Err(PyTypeError::new_err(format!(
-                "faces: expected an integer dtype (vertex indices), got dtype {dt}"
-            )))
-        }
+        out.push(f);
     }
     Ok(out)
 }
