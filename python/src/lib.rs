@@ -838,12 +838,75 @@ fn _packed_rays() -> u64 {
 }
 
 /// The native half of the ``raytrail`` package; import ``raytrail`` instead.
+/// The conformance crate's exact judgement of answers `prim` (int64, -1 a miss) at `t` for the
+/// float32 rays `rays` (N, 8) in `scene`: per ray "exact", "near" or "disagree: why" (see
+/// `raytrail_conformance::exact::verdict`). A NaN `t` stands for the ray's `t` at the plane of
+/// face `prim` (for a tracer that reports only the face). A test hook (feature `exact-reference`): it lets the
+/// tests judge any tracer's answers, embreex's included, by the reference the suite uses.
+#[cfg(feature = "exact-reference")]
+#[pyfunction]
+fn _exact_judge(
+    scene: &Scene,
+    rays: numpy::PyReadonlyArray2<'_, f32>,
+    prim: numpy::PyReadonlyArray1<'_, i64>,
+    t: numpy::PyReadonlyArray1<'_, f32>,
+) -> PyResult<Vec<String>> {
+    use raytrail_conformance::exact::{judge, ExactScene, Judgement, Tolerance};
+    let (rays, prim, t) = (rays.as_array(), prim.as_array(), t.as_array());
+    if rays.ncols() != 8 || prim.len() != rays.nrows() || t.len() != rays.nrows() {
+        return Err(value_error("_exact_judge: rays (N, 8), prim (N,) and t (N,) expected".into()));
+    }
+    let triangles: Vec<raytrail::core::geometry::Triangle> = scene
+        .faces
+        .iter()
+        .map(|f| {
+            let v = f.map(|i| raytrail::Vec3::from_array(scene.vertices[i as usize]));
+            raytrail::core::geometry::Triangle::new(v[0], v[1], v[2])
+        })
+        .collect();
+    let scale = triangles.iter().flat_map(|t| t.v).fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+    let tol = Tolerance::for_scene(scale);
+    let exact = ExactScene::new(triangles);
+    Ok((0..rays.nrows())
+        .map(|i| {
+            let r = rays.row(i);
+            let ray = Ray { origin: [r[0], r[1], r[2]], tmin: r[3], dir: [r[4], r[5], r[6]], tmax: r[7] };
+            let hit = match prim[i] {
+                p if p >= 0 && (p as usize) < scene.faces.len() => {
+                    let t = if t[i].is_nan() { plane_t(&ray, &exact.triangles()[p as usize]) as f32 } else { t[i] };
+                    Hit { t, prim: p as u32, u: 0.0, v: 0.0 }
+                }
+                p if p >= 0 => Hit { t: t[i], prim: p as u32, u: 0.0, v: 0.0 },
+                _ => Hit::MISS,
+            };
+            match judge(&ray, exact.triangles(), &exact.closest_hit(&ray), &hit, tol, false) {
+                Judgement::Exact => "exact".to_string(),
+                Judgement::Near => "near".to_string(),
+                Judgement::Refused => "refused".to_string(),
+                Judgement::Disagree(why) => format!("disagree: {why}"),
+            }
+        })
+        .collect())
+}
+
+/// The `t` at which `ray` meets the plane of `tri`, in `f64`.
+#[cfg(feature = "exact-reference")]
+fn plane_t(ray: &Ray, tri: &raytrail::core::geometry::Triangle) -> f64 {
+    let f = |v: raytrail::Vec3| v.as_dvec3();
+    let (a, b, c) = (f(tri.v[0]), f(tri.v[1]), f(tri.v[2]));
+    let (o, d) = (f(ray.origin()), f(ray.dir()));
+    let n = (b - a).cross(c - a);
+    n.dot(a - o) / n.dot(d)
+}
+
 #[pymodule]
 fn _raytrail(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add_class::<Scene>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(_packed_rays, m)?)?;
+    #[cfg(feature = "exact-reference")]
+    m.add_function(wrap_pyfunction!(_exact_judge, m)?)?;
     let names: Vec<&str> = std::iter::once("auto").chain(Method::ALL.iter().map(|m| m.name())).collect();
     m.add("METHODS", PyTuple::new(py, names)?)?;
     m.add("REFUSED", REFUSED)?;

@@ -4,8 +4,14 @@ Where raytrail and another tracer disagree on a ray, the exact answer decides: M
 float64 over every triangle (conftest.Judge). The test requires raytrail to be right on every
 disagreeing ray, and each disagreement to be either the other tracer being wrong or a tie (both
 faces hit at the same distance, e.g. coplanar faces or a ray through a shared edge, which
-raytrail settles by the lower face index). It prints the counts.
+raytrail settles by the lower face index). It prints the counts. Then the conformance crate's
+exact reference (integer arithmetic on the float32 rays and triangles the tracers see, built into
+the test wheel by the `exact-reference` feature) judges both answers on every disagreeing ray:
+raytrail's must be exact or within the suite's tolerance, and the other tracer is counted wrong
+where that reference says so.
 """
+
+import os
 
 import numpy as np
 import pytest
@@ -47,6 +53,7 @@ def judge_disagreements(name, peer, ours, other, origins, directions, triangles)
     graze = ~np.isfinite(judge.tight[rows, np.maximum(near, 0)])
     tie = other_right
     assert np.all(same_t[tie] | graze[tie]), f"{name}: a disagreement that is neither a tie nor {peer}'s error"
+    exact_judgement(name, peer, ours[differ], other[differ], origins[differ], directions[differ], triangles)
     wrong = int((~other_right).sum())
     print(
         f"{name}: {len(differ)} of {len(ours)} rays differ from {peer}; the float64 reference judges "
@@ -55,6 +62,61 @@ def judge_disagreements(name, peer, ours, other, origins, directions, triangles)
         f"grazing an edge"
     )
     return len(differ), wrong, int(tie.sum())
+
+
+def exact_verdicts(origins, directions, triangles, prim, t=None):
+    """The conformance crate's exact verdict ("exact", "near", "disagree: why") on each answer
+    `prim` (at `t`, or at its face's plane where `t` is None) for the float32 rays a tracer sees;
+    None where the wheel lacks the exact reference (a failure under RAYTRAIL_REQUIRE_EXACT=1)."""
+    judge = getattr(raytrail._raytrail, "_exact_judge", None)
+    if judge is None:
+        assert os.environ.get("RAYTRAIL_REQUIRE_EXACT") != "1", "the wheel lacks the exact reference (feature exact-reference)"
+        print("the wheel lacks the exact reference (build with --features exact-reference): float64 judgement only")
+        return None
+    scene = raytrail.Scene(np.asarray(triangles).reshape(-1, 3), np.arange(3 * len(triangles)).reshape(-1, 3))
+    n = len(origins)
+    rays = np.zeros((n, 8), np.float32)
+    rays[:, 0:3], rays[:, 4:7], rays[:, 7] = origins, directions, np.inf
+    t = np.full(n, np.nan, np.float32) if t is None else np.asarray(t, np.float32)
+    return judge(scene, rays, np.asarray(prim, np.int64), t)
+
+
+def exact_judgement(name, peer, ours, other, origins, directions, triangles):
+    """Prints the exact reference's verdicts on both answers where raytrail and `peer` differ
+    (raytrail's own answers on every ray are held to it by test_exact_reference_on_every_ray)."""
+    ours_v = exact_verdicts(origins, directions, triangles, ours)
+    if ours_v is None:
+        return
+    other_v = exact_verdicts(origins, directions, triangles, other)
+    wrong = lambda vs: sum(v.startswith("disagree") for v in vs)  # noqa: E731
+    print(f"{name}: of {len(ours)} rays that differ from {peer}, the exact reference judges raytrail wrong "
+          f"on {wrong(ours_v)} and {peer} wrong on {wrong(other_v)}")
+
+
+# Known, and open (docs/notes/2026-12-02-library-surface-and-python.md): on these meshes a few
+# of the 20,000 rays, from about three times the scene's size away, get an answer the exact
+# reference puts outside the suite's tolerance (64 ulps of the scene's magnitude, not growing
+# with the origin's distance): rays aimed exactly at a vertex land on a face the exact ray passes
+# outside by about twice that (teapot 3, icosphere 4), and on the annulus two hits on the right
+# face have t off by ~6e-5 of t. The conformance suite's own rays never met these cases.
+KNOWN_EXACT_MISSES = {"teapot", "icosphere", "annulus"}
+
+
+@pytest.mark.parametrize("name", MESHES)
+def test_exact_reference_on_every_ray(meshes, name, request):
+    """raytrail's closest hits on the embreex test's rays, every one judged by the conformance
+    crate's exact reference: exact, or near within the suite's tolerance."""
+    if name in KNOWN_EXACT_MISSES:
+        request.applymarker(pytest.mark.xfail(strict=True, reason="known: vertex-aimed rays beyond the tolerance"))
+    mesh = meshes[name]
+    origins, directions = rays_at(np.asarray(mesh.vertices), 20000, seed=2)
+    hits = raytrail.Scene(mesh.vertices, mesh.faces).intersect(origins, directions)
+    verdicts = exact_verdicts(origins, directions, mesh.triangles, hits.prim, hits.t)
+    if verdicts is None:
+        pytest.skip("the wheel lacks the exact reference")
+    bad = [(i, v) for i, v in enumerate(verdicts) if v not in ("exact", "near")]
+    print(f"{name}: the exact reference judges raytrail wrong on {len(bad)} of {len(verdicts)} rays")
+    assert not bad, f"{name}: {bad[:3]}"
 
 
 @pytest.mark.parametrize("name", MESHES)
