@@ -65,6 +65,6 @@ impl Ray {
             | non_finite(self.dir[1])
             | non_finite(self.dir[2]);
         let dir = (bits(self.dir[0]) | bits(self.dir[1]) | bits(self.dir[2])) & 0x7fff_ffff;
-        bad | u32::from(dir == 0) | u32::from(!(self.tmin <= self.tmax))
+        bad | u32::from(dir == 0) | (1 - u32::from(self.tmin <= self.tmax))
     }
 }
