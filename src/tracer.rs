@@ -228,7 +228,7 @@ impl Tracer {
         raytrail_core::trace::check_buffers(rays, hits)?;
         if self.reject_untraceable {
             if let Some(first) = rays.iter().position(|r| !r.is_traceable()) {
-                let count = rays[first..].iter().filter(|r| !r.is_traceable()).count();
+                let count = raytrail_core::trace::count_untraceable(&rays[first..]);
                 return Err(Error::UntraceableRays { count, first });
             }
         }

@@ -851,6 +851,7 @@ fn _exact_judge(
     prim: numpy::PyReadonlyArray1<'_, i64>,
     t: numpy::PyReadonlyArray1<'_, f32>,
 ) -> PyResult<Vec<String>> {
+    use raytrail_conformance::exact::verdict::plane_t;
     use raytrail_conformance::exact::{judge, ExactScene, Judgement, Tolerance};
     let (rays, prim, t) = (rays.as_array(), prim.as_array(), t.as_array());
     if rays.ncols() != 8 || prim.len() != rays.nrows() || t.len() != rays.nrows() {
@@ -864,8 +865,8 @@ fn _exact_judge(
             raytrail::core::geometry::Triangle::new(v[0], v[1], v[2])
         })
         .collect();
-    let scale = triangles.iter().flat_map(|t| t.v).fold(0.0f32, |m, v| m.max(v.abs().max_element()));
-    let tol = Tolerance::for_scene(scale);
+    let bounds = triangles.iter().fold(raytrail::core::Aabb::EMPTY, |b, t| b.union(t.bounds()));
+    let tol = Tolerance::for_scene(bounds.max_abs());
     let exact = ExactScene::new(triangles);
     Ok((0..rays.nrows())
         .map(|i| {
@@ -887,16 +888,6 @@ fn _exact_judge(
             }
         })
         .collect())
-}
-
-/// The `t` at which `ray` meets the plane of `tri`, in `f64`.
-#[cfg(feature = "exact-reference")]
-fn plane_t(ray: &Ray, tri: &raytrail::core::geometry::Triangle) -> f64 {
-    let f = |v: raytrail::Vec3| v.as_dvec3();
-    let (a, b, c) = (f(tri.v[0]), f(tri.v[1]), f(tri.v[2]));
-    let (o, d) = (f(ray.origin()), f(ray.dir()));
-    let n = (b - a).cross(c - a);
-    n.dot(a - o) / n.dot(d)
 }
 
 #[pymodule]

@@ -93,7 +93,7 @@ def exact_judgement(name, peer, ours, other, origins, directions, triangles):
           f"on {wrong(ours_v)} and {peer} wrong on {wrong(other_v)}")
 
 
-# Known, and open (docs/notes/2026-12-02-library-surface-and-python.md): on these meshes a few
+# Known, and open (issue 54's note in docs/notes/): on these meshes a few
 # of the 20,000 rays, from about three times the scene's size away, get an answer the exact
 # reference puts outside the suite's tolerance (64 ulps of the scene's magnitude, not growing
 # with the origin's distance): rays aimed exactly at a vertex land on a face the exact ray passes

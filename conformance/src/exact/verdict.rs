@@ -59,8 +59,8 @@ pub enum Judgement {
     Disagree(String),
 }
 
-/// The plane `t` of `tri` along `ray`, in `f64`.
-fn plane_t(ray: &Ray, tri: &Triangle) -> f64 {
+/// The plane `t` of `tri` along `ray`, in `f64` (where a method's `t` on `tri` is judged).
+pub fn plane_t(ray: &Ray, tri: &Triangle) -> f64 {
     let v = |p: [f32; 3]| p.map(f64::from);
     let [a, b, c] = tri.v.map(|p| v(p.to_array()));
     let (o, d) = (v(ray.origin), v(ray.dir));
