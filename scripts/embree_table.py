@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The Embree table of BENCHMARKS.md from `raytrail bench --json` files.
+"""The Embree table of the benchmark notes (docs/notes/) from `raytrail bench --json` files.
 
     scripts/embree_table.py NEW.json [NEW.json ...] [--before OLD.json ...]
 

@@ -19,8 +19,8 @@
 # binary) under $OUT (else /tmp/gpu-out). `quick` shrinks everything for a dry run on lavapipe;
 # SKIP_CONF=1 skips the suites, SUITES=conformance runs the grid suite alone (about 40 s on an
 # H200, half of both); METHODS=a,b,... replaces the bench's methods. On an H100 the grid
-# suite and the three scenes took about 4 minutes (BENCHMARKS.md, "On an NVIDIA H100
-# (2026-11-27)").
+# suite and the three scenes took about 4 minutes
+# (`docs/notes/*-benchmarks-h100-suite.md`, "On an NVIDIA H100").
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 carry=$root/dev-carry

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Markdown tables for BENCHMARKS.md from `raytrail bench --json` runs of the stream method.
+"""Markdown tables for the notes (docs/notes/) from `raytrail bench --json` runs of the stream method.
 
 Usage: stream_tables.py RUN.json [RUN.json ...]
 With several runs (the same command repeated), each speed is the median over the runs.

@@ -1,7 +1,7 @@
 // Method kd-packet: the packetized short-stack traversal of Horn et al. 2007, A.5, with push-down
 // (`kd::traverse::trace_kd_packet::<4>` as the CPU backend calls it). One invocation traces a
 // packet of four consecutive rays of the batch, which the host has grouped by direction octant
-// as the CPU does (backends/wgpu/src/packets.rs), so they share every node's child order.
+// as the CPU does (core/src/traverse/packets.rs), so they share every node's child order.
 //
 // The packet descends where any live lane's segment goes; each lane stays live only where its own
 // segment goes and restarts from the exit of the last leaf it was live in, so it visits exactly

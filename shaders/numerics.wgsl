@@ -119,7 +119,7 @@ fn div_rn(a: f32, b: f32) -> f32 {
         e = e - 1;
     }
     // Quotient in [1, 2): 24 significand bits and one guard bit, five bits per call and no
-    // loop (llvmpipe silently cuts loops that run too long in total, see NUMERICS.md).
+    // loop (llvmpipe silently cuts loops that run too long in total, see backends/wgpu/NUMERICS.md).
     var qr = vec2<u32>(0u, num);
     qr = div_bits5(qr, den);
     qr = div_bits5(qr, den);

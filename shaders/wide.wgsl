@@ -10,8 +10,8 @@
 // generated header. The buffer is bound twice: as `kd`, word by word, for the nodes, and as `bvh`,
 // 16 bytes at a time, for the triangles. A triangle at a 36-byte stride took ten word loads that
 // no compiler can merge; three aligned entries take three. The nodes stay word loads: read as
-// 16-byte rows they ran 0-20% slower on an H100 (BENCHMARKS.md, "the box tests reading 16-byte
-// words").
+// 16-byte rows they ran 0-20% slower on an H100
+// (`docs/notes/*-benchmarks-h100-suite.md`, "Tried on the H100 and not kept").
 
 const WIDE_EMPTY: u32 = 0xffffffffu;
 
@@ -93,9 +93,9 @@ fn wide_test_child(node: u32, i: u32, lo_t: f32, hi_t: f32) -> u32 {
 }
 
 // 4-wide: written out child by child, as `wide_sort` is, rather than left to the driver to unroll;
-// on an H200 that made bvh4 1.00-1.18x faster (BENCHMARKS.md, "Loops written out"). 8-wide: the
-// loop, since written out there (with the stack's pushes) it lost 7-9% on AO and diffuse rays
-// while gaining on primary ones.
+// on an H200 that made bvh4 1.00-1.18x faster (`docs/notes/*-benchmarks-h200.md`, "Loops written out").
+// 8-wide: the loop, since written out there (with the stack's pushes) it lost 7-9% on AO and
+// diffuse rays while gaining on primary ones.
 fn wide_test(node: u32, lo_t: f32, hi_t: f32) -> u32 {
     if WIDE_W == 4u {
         return wide_test_child(node, 0u, lo_t, hi_t) | wide_test_child(node, 1u, lo_t, hi_t)

@@ -135,8 +135,9 @@ pub enum Command {
     /// Times raytrail's methods and the peer libraries on the same rays
     #[command(
         long_about = "Times raytrail's methods and the peers (obvhs-bvh2, obvhs-cwbvh, bvh; each also as NAME+wt \
-                      with raytrail's watertight test; embree, own test only, in a binary built with `--features \
-                      embree`) on the same rays on the same thread pool; prints Mrays/s (median of N passes after a \
+                      with raytrail's watertight test; embree and embree-high, Embree's default and high build \
+                      qualities, own test only, in a binary built with `--features embree`; `--baseline \
+                      embree-best` takes the faster of the two per batch) on the same rays on the same thread pool; prints Mrays/s (median of N passes after a \
                       warm-up), the ratio to the baseline, work per ray, build times, memory and hit agreement with \
                       the stack method. Views: the camera outside the scene framing it, or inside it (low in its \
                       box, looking along the long side, 90-degree field of view); `auto` adds the inside view where \

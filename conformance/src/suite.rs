@@ -207,14 +207,32 @@ pub fn mismatch_report(scene: &str, backend: &str, checked: usize, mismatches: &
 /// Defines one `#[test]` per [`Case`] of the suite for a backend:
 /// `conformance_suite!(CpuBackend::new());`, or with `try` for a constructor returning a
 /// `Result` (the backend is then made once per test binary, and skipped if it cannot be made
-/// unless [`REQUIRE_GPU`] is 1).
+/// unless [`REQUIRE_GPU`] is 1). `small: try ...` defines only the cases that reach every kernel
+/// and both key widths without the large meshes (generated scenes, the Cornell box and the
+/// teapot), for a second configuration of a backend whose every kernel the full suite already
+/// ran on every mesh.
 #[macro_export]
 macro_rules! conformance_suite {
+    (small: try $make:expr) => {
+        $crate::conformance_suite!(@small |case| $crate::suite::run_case_or_skip(|| $make, case));
+    };
     (try $make:expr) => {
         $crate::conformance_suite!(@cases |case| $crate::suite::run_case_or_skip(|| $make, case));
     };
     ($make:expr) => {
         $crate::conformance_suite!(@cases |case| $crate::suite::run_case(&$make, case));
+    };
+    (@small $run:expr) => {
+        $crate::conformance_suite!(@each $run;
+            shared_edge_grid => SharedEdgeGrid,
+            sphereflake => Sphereflake,
+            triangle_soup => TriangleSoup,
+            degenerate_stack_needs_and_uses_64_bit_keys => DegenerateStack,
+            far_from_origin => FarFromOrigin,
+            tiny_cases => TinyCases,
+            cornell_box => Mesh("cornell_box.obj"),
+            teapot => Mesh("teapot.obj"),
+        );
     };
     (@cases $run:expr) => {
         $crate::conformance_suite!(@each $run;

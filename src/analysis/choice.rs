@@ -7,8 +7,8 @@
 use raytrail_core::method::{Bvh2Method, KdMethod, Method, StreamMethod, WideMethod};
 use raytrail_core::Error;
 
-/// The methods `auto` chooses among, one per family that was the fastest somewhere in
-/// BENCHMARKS.md: the 8-wide tree (most secondary rays, every dragon ray), the same tree walked by
+/// The methods `auto` chooses among, one per family that was the fastest somewhere in the notes
+/// (`docs/notes/`): the 8-wide tree (most secondary rays, every dragon ray), the same tree walked by
 /// packets (camera rays inside rooms, shadow rays to one light through deep geometry), the kd
 /// stack traversal (primary rays in architectural scenes), the BVH2 stack method (some coherent
 /// shadow rays) and the ray-stream method (coherent primary rays inside rooms). The others each trail one of these

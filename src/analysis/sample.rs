@@ -22,7 +22,7 @@ pub const MAX_SAMPLE: usize = 8192;
 /// per ray differs by region of an image, and by more between methods than the 10% `auto` may
 /// lose. Four runs of 307 camera rays into the kitchen made kd-stack look 30% faster than bvh8,
 /// which was 15% faster over the whole batch; sixteen runs of 77 ranked the two as the batch did
-/// (BENCHMARKS.md, "`--method auto`: a sample of sixteen runs").
+/// (`docs/notes/*-benchmarks-leaf-cost-and-auto-sample.md`, "`--method auto`: a sample of sixteen runs").
 pub const SAMPLE_RUNS: usize = 16;
 
 /// Runs of the sample, and their quarters in the first look, are whole multiples of this many

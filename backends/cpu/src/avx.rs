@@ -3,9 +3,10 @@
 //! compiled for AVX2 (so the 4-wide SSE code and the triangle tests get its three-operand encoding
 //! too) and for the bit instructions every AVX2 processor has (BMI1, BMI2, LZCNT, POPCNT): without
 //! them a mask's `count_ones` was a multiply sequence on the path to every node's order, and each
-//! `trailing_zeros` a branchy `bsf` (1.01-1.03 on most ray sets; BENCHMARKS.md, "Triangle blocks
-//! that carry their primitive ids"). Every answer and every order is the reference kernel's bit
-//! for bit; the tests below hold them to that on adversarial values.
+//! `trailing_zeros` a branchy `bsf` (1.01-1.03 on most ray sets;
+//! `docs/notes/*-benchmarks-leaf-blocks.md`, "Triangle blocks that carry their primitive ids").
+//! Every answer and every order is the reference kernel's bit for bit; the tests below hold them to
+//! that on adversarial values.
 
 use raytrail_core::intersect::{SlabRay, TriangleTest, FAR_PAD};
 use raytrail_core::key::Key;
@@ -112,7 +113,7 @@ unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, t
             // Planes picked by the direction's sign (`negative`, as the reference picks them) as
             // an address rather than by a blend of both: the loads start the chain, and per-ray
             // constant signs keep the choice predicted. 1.02 on the kitchen's inside camera and
-            // diffuse rays (BENCHMARKS.md, "Packets' box tests by ray").
+            // diffuse rays (`docs/notes/*-benchmarks-leaf-blocks.md`, "Packets' box tests by ray").
             let (np, fp) = if s.negative[a] { (&node.hi[a], &node.lo[a]) } else { (&node.lo[a], &node.hi[a]) };
             // SAFETY: eight floats inside arrays of `W`, from `lane <= W - 8`.
             let (near, far) =

@@ -3,7 +3,8 @@
 //! for all eight lanes per operation. Made ray by ray, the setup (the acceptance test, the
 //! reciprocal direction, the slack, the box interval, the packet's bounds) and the copies of each
 //! ray's context into its lane were about half the instructions of a kitchen shadow ray that its
-//! packet answers at its first leaf (BENCHMARKS.md, "Packet lanes made eight rays at a time").
+//! packet answers at its first leaf
+//! (`docs/notes/*-benchmarks-packet-lanes.md`, "Packet lanes made eight rays at a time").
 //!
 //! Each lane is the scalar setup's operations in their order (`Ray::is_traceable`,
 //! `SlabRay::with_slack`, `SlabRay::widen`), so the lanes equal

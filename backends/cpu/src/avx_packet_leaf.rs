@@ -8,16 +8,17 @@
 //! order (a per-lane permutation of the triangle's nine floats), then the SSE block test's
 //! operations in its order. The rays' constants for the test (axis order, shear) are made for the
 //! eight lanes at once from the rays as given, not ray by ray: 1.16x on the kitchen's inside shadow
-//! rays, whose packets test one leaf each (601 to 536 instructions a ray; BENCHMARKS.md,
-//! "Instructions per ray"). A lane with a zero edge function, or with a hit the error bound flags,
-//! takes the scalar test, with its ray's constants made for it. The answers are the single-ray
+//! rays, whose packets test one leaf each (601 to 536 instructions a ray;
+//! `docs/notes/*-benchmarks-instructions.md`, "Instructions per ray"). A lane with a zero edge
+//! function, or with a hit the error bound flags, takes the scalar test, with its ray's constants
+//! made for it. The answers are the single-ray
 //! leaf's bit for bit, and each ray's events come in its order (triangle by triangle, up to an
 //! any-hit answer).
 //!
 //! The arithmetic is the SSE block test's (`raytrail_core`'s watertight test) written again for
 //! 256-bit registers. One form generic over the register width would call the AVX intrinsics from
 //! a function not compiled for AVX, and the compiler then leaves them as calls (0.18-0.84x when
-//! tried: BENCHMARKS.md, "Packet leaves with the rays in the lanes").
+//! tried: `docs/notes/*-benchmarks-packet-leaves.md`, "Packet leaves with the rays in the lanes").
 
 use raytrail_core::intersect::{TriangleHit, TriangleTest, REFINE_SCALE};
 use raytrail_core::observe::Observer;

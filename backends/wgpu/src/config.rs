@@ -33,8 +33,8 @@ impl Dispatch {
     /// grid for every other. On an H100 at 2M rays, bvh4 and bvh8 ran 1.0-3.1x faster with
     /// persistent threads than on the grid on all 8 scene and ray type pairs measured (bvh4-naive
     /// and bvh8-sah run the same kernel); the binary stack and `bvh4-hash` ran faster on the grid
-    /// on 7 of the 8, and the packet kernel alike on both (BENCHMARKS.md, "On an NVIDIA H100
-    /// (2026-11-27)").
+    /// on 7 of the 8, and the packet kernel alike on both.
+    /// Measured in `docs/notes/*-benchmarks-h100-suite.md`, "On an NVIDIA H100".
     pub fn for_method(self, method: Method) -> Dispatch {
         match self {
             Dispatch::ByMethod => match method.wide() {

@@ -9,8 +9,8 @@
 //! CPU passes take seconds in which the GPU drops to idle clocks: interleaved, the same kernel
 //! measured up to 5x slower from one row to the next on an H100. So a GPU target's passes run back
 //! to back after [`CLOCK_SPIN`] of untimed tracing (which narrows the spread but does not remove
-//! it: BENCHMARKS.md, the H100 section). Work per ray is counted in one more untimed pass, on the
-//! largest pool.
+//! it: `docs/notes/*-benchmarks-h100-host.md`, "GPU Mrays/s on the H100"). Work per ray is counted
+//! in one more untimed pass, on the largest pool.
 
 use super::agreement::{compare, Agreement};
 use super::rays::RayBatch;
@@ -118,11 +118,28 @@ impl Plan<'_> {
     }
 }
 
-/// Sets each row's ratio to the baseline's speed at the same thread count.
+/// Sets each row's ratio to the baseline's speed at the same thread count. The baseline
+/// [`EMBREE_BEST`] is the faster of `embree` and `embree-high` on each batch and thread count.
 fn set_ratios(rows: &mut [Row], baseline: &str) {
-    let base: Vec<(usize, f64)> =
-        rows.iter().filter(|r| r.target == baseline).map(|r| (r.threads, r.mrays_per_s)).collect();
-    for r in rows {
-        r.ratio = base.iter().find(|b| b.0 == r.threads && b.1 > 0.0).map(|b| r.mrays_per_s / b.1);
+    let is_base = |target: &str| {
+        if baseline == EMBREE_BEST {
+            crate::bench::peers::is_embree(target)
+        } else {
+            target == baseline
+        }
+    };
+    let speed = |threads: usize| {
+        rows.iter()
+            .filter(|r| r.threads == threads && is_base(&r.target) && r.mrays_per_s > 0.0)
+            .map(|r| r.mrays_per_s)
+            .reduce(f64::max)
+    };
+    let base: Vec<(usize, Option<f64>)> = rows.iter().map(|r| (r.threads, speed(r.threads))).collect();
+    for (r, (_, b)) in rows.iter_mut().zip(base) {
+        r.ratio = b.map(|b| r.mrays_per_s / b);
     }
 }
+
+/// The baseline that is the faster Embree peer per batch: `--baseline embree-best`, with both
+/// `embree` and `embree-high` among the peers.
+pub const EMBREE_BEST: &str = "embree-best";

@@ -105,10 +105,18 @@ fn check_baseline(opts: &Options) -> Result<(), String> {
     for p in &opts.peers {
         names.extend(peers::target_names(p));
     }
-    if names.contains(&opts.baseline) {
+    let best_of_embree = opts.baseline == measure::EMBREE_BEST
+        && ["embree", "embree-high"].iter().all(|p| opts.peers.iter().any(|q| q == p));
+    if best_of_embree || names.contains(&opts.baseline) {
         Ok(())
     } else {
-        Err(format!("--baseline: '{}' is not measured in this run (measured: {})", opts.baseline, names.join(", ")))
+        Err(format!(
+            "--baseline: '{}' is not measured in this run (measured: {}; '{}' needs the peers embree and \
+             embree-high)",
+            opts.baseline,
+            names.join(", "),
+            measure::EMBREE_BEST
+        ))
     }
 }
 
@@ -184,7 +192,7 @@ fn bench_scene(
     };
     let mut reports = Vec::new();
     for &view in opts.view.views() {
-        let primary = rays::primary_rays(scene, view, opts.width, opts.height);
+        let primary = opts.order.primary_rays(scene, view, opts.width, opts.height);
         let mut primary_hits = vec![Hit::MISS; primary.len()];
         stack.trace(largest, &primary, Query::Closest, &mut primary_hits)?;
         let enclosure = Enclosure::of(&primary, &primary_hits, scene.triangles());
@@ -199,7 +207,8 @@ fn bench_scene(
             );
             continue;
         }
-        let batches = rays::batches(&opts.rays, scene, &primary, &primary_hits, opts.ao_rays);
+        let mut batches = rays::batches(&opts.rays, scene, &primary, &primary_hits, opts.ao_rays);
+        opts.order.arrange(&mut batches);
         let mut references = Vec::with_capacity(batches.len());
         for b in &batches {
             let mut hits = vec![Hit::MISS; b.rays.len()];
@@ -356,8 +365,9 @@ mod tests {
         assert_eq!(views.iter().map(|s| s.view).collect::<Vec<_>>(), [View::Outside, View::Inside]);
         assert_eq!(printed, views.iter().map(|s| s.name.clone()).collect::<Vec<_>>());
         assert!(views[1].name.ends_with(" (inside)") && !views[0].name.contains("inside"));
-        // 3 methods, 3 peers with 2 variants each, and Embree (own test only) with its feature.
-        let rows = if cfg!(feature = "embree") { 10 } else { 9 };
+        // 3 methods, 3 peers with 2 variants each, and Embree at two build qualities (own test
+        // only) with its feature.
+        let rows = if cfg!(feature = "embree") { 11 } else { 9 };
         for s in &views {
             assert_eq!(s.rays.len(), rays::RayKind::ALL.len());
             assert!(s.builds.iter().any(|b| b.what.starts_with("obvhs-cwbvh")));
@@ -394,6 +404,8 @@ mod tests {
         assert!(check_baseline(&parse("--peers bvh --baseline obvhs-bvh2")).is_err());
         if cfg!(feature = "embree") {
             assert!(check_baseline(&parse("--peers embree --baseline embree")).is_ok());
+            assert!(check_baseline(&parse("--peers embree,embree-high --baseline embree-best")).is_ok());
+            assert!(check_baseline(&parse("--peers embree --baseline embree-best")).is_err());
             // Embree has no watertight variant.
             assert!(check_baseline(&parse("--peers embree --baseline embree+wt")).is_err());
         }

@@ -1,6 +1,7 @@
 //! The `raytrail bench` flags, parsed and checked before any work starts.
 
 use super::rays::RayKind;
+use super::rays::RayOrder;
 use super::view::ViewChoice;
 use crate::args::BUILTIN_SCENE;
 use crate::args::{LoadFlags, AUTO, BUILDERS};
@@ -28,7 +29,7 @@ pub const DEFAULT_AO_RAYS: usize = 4;
 pub const PEERS: &[&str] = &["obvhs-bvh2", "obvhs-cwbvh", "bvh"];
 /// The peers a run can include, by command-line name (`embree` with the `embree` cargo feature).
 #[cfg(feature = "embree")]
-pub const PEERS: &[&str] = &["obvhs-bvh2", "obvhs-cwbvh", "bvh", "embree"];
+pub const PEERS: &[&str] = &["obvhs-bvh2", "obvhs-cwbvh", "bvh", "embree", "embree-high"];
 
 /// What to measure, and where to write it.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,6 +66,8 @@ pub struct Options {
     pub no_gpu: bool,
     /// Which camera views each scene is measured from.
     pub view: ViewChoice,
+    /// The order of the rays ([`RayOrder`]).
+    pub order: RayOrder,
     /// Fail on mesh elements that are not triangles or polygons instead of skipping them.
     pub strict: bool,
     /// Parameter sets of the stream method: one target per set (the first is the default's).
@@ -144,6 +147,10 @@ pub struct BenchArgs {
     /// Camera views: outside, inside, both, or auto (inside too where it sees a room)
     #[arg(long, default_value = ViewChoice::DEFAULT.name(), value_parser = ViewChoice::ALL.map(ViewChoice::name))]
     pub view: String,
+    /// Ray order: morton (camera rays on a Z-curve, secondary rays after them), raster (camera
+    /// rays row by row), shuffled (secondary rays in no order, as a path tracer's later bounces)
+    #[arg(long, default_value = "morton", value_parser = RayOrder::ALL.map(RayOrder::name))]
+    pub order: String,
     #[command(flatten)]
     pub load: LoadFlags,
 }
@@ -206,11 +213,12 @@ impl Options {
             v => {
                 let given = unique(list(v));
                 if let Some(bad) = given.iter().find(|p| !PEERS.contains(&p.as_str())) {
-                    if bad == "embree" {
-                        return Err("--peers: 'embree' is not available: this raytrail binary was built without the \
-                                    `embree` cargo feature (rebuild with `--features embree`, which links the \
-                                    system's libembree3)"
-                            .to_string());
+                    if crate::bench::peers::is_embree(bad) {
+                        return Err(format!(
+                            "--peers: '{bad}' is not available: this raytrail binary was built without the \
+                             `embree` cargo feature (rebuild with `--features embree`, which links the system's \
+                             libembree3)"
+                        ));
                     }
                     return Err(format!("--peers: unknown peer '{bad}' (known: {}, all, none)", PEERS.join(", ")));
                 }
@@ -286,6 +294,7 @@ impl Options {
             ao_rays,
             no_gpu: a.no_gpu,
             view: ViewChoice::from_name(&a.view)?,
+            order: RayOrder::from_name(&a.order).ok_or_else(|| format!("--order: unknown order '{}'", a.order))?,
             strict: a.load.strict,
         })
     }
@@ -412,6 +421,8 @@ mod tests {
         assert_eq!(o.view, ViewChoice::DEFAULT);
         assert!(!o.strict && parse("--strict").unwrap().strict);
         assert_eq!(parse("--view both").unwrap().view, ViewChoice::Both);
+        assert_eq!(o.order, RayOrder::Morton);
+        assert_eq!(parse("--order shuffled").unwrap().order, RayOrder::Shuffled);
         let e = parse("--scene a.obj --colour red").unwrap_err();
         assert!(e.contains("unexpected argument '--colour'"), "{e}");
         let o = parse("--scene a.obj,,b.ply --rays ao,primary,ao --threads 2,1,2 --methods hash,stack").unwrap();
@@ -435,6 +446,7 @@ mod tests {
             "--methods fastest",
             "--peers bvh,fastest",
             "--view above",
+            "--order sorted",
             "--threads 0",
             "--passes 0",
             "--width 0",
@@ -460,5 +472,6 @@ mod tests {
         assert_eq!(parse("--peers embree").unwrap().peers, vec!["embree"]);
         assert!(parse("--peers all").unwrap().peers.contains(&"embree".to_string()));
         assert!(parse("--peers embree --baseline embree").is_ok());
+        assert!(parse("--peers all").unwrap().peers.contains(&"embree-high".to_string()));
     }
 }

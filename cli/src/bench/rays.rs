@@ -115,6 +115,68 @@ pub fn primary_rays(scene: &Scene, view: View, width: u32, height: u32) -> Vec<R
     primary_from(&view.camera(scene.bounds()), width, height)
 }
 
+/// The order a run's rays come in. The secondary rays are made from the primary hits in the
+/// primary rays' order, so the stream and packet walks, which gain from neighbours that go the
+/// same way, see that coherence unless the rays are shuffled: a path tracer's later bounces
+/// come in no useful order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayOrder {
+    /// Camera rays along a Z-curve over the image, secondary rays following them.
+    Morton,
+    /// Camera rays row by row, secondary rays following them (their random directions are drawn
+    /// per primary ray by its place in this order, so they are other draws than Morton's).
+    Raster,
+    /// Camera rays as for Morton; every secondary batch shuffled by a fixed seed.
+    Shuffled,
+}
+
+impl RayOrder {
+    /// Every order, the default first.
+    pub const ALL: [RayOrder; 3] = [RayOrder::Morton, RayOrder::Raster, RayOrder::Shuffled];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            RayOrder::Morton => "morton",
+            RayOrder::Raster => "raster",
+            RayOrder::Shuffled => "shuffled",
+        }
+    }
+
+    /// The order of a command-line name.
+    pub fn from_name(name: &str) -> Option<RayOrder> {
+        Self::ALL.into_iter().find(|o| o.name() == name)
+    }
+
+    /// Primary rays of `view` of `scene` in this order.
+    pub fn primary_rays(self, scene: &Scene, view: View, width: u32, height: u32) -> Vec<Ray> {
+        match self {
+            RayOrder::Morton | RayOrder::Shuffled => primary_rays(scene, view, width, height),
+            RayOrder::Raster => {
+                let camera = view.camera(scene.bounds());
+                (0..height)
+                    .flat_map(|y| (0..width).map(move |x| (x, y)))
+                    .map(|(x, y)| camera.ray(x as f32 + 0.5, y as f32 + 0.5, width, height))
+                    .collect()
+            }
+        }
+    }
+
+    /// Puts the secondary batches of `batches` in this order (the shuffle's seed is fixed per
+    /// ray kind, so every run and every target sees the same sequence).
+    pub fn arrange(self, batches: &mut [RayBatch]) {
+        if self != RayOrder::Shuffled {
+            return;
+        }
+        for b in batches.iter_mut().filter(|b| b.kind != RayKind::Primary) {
+            Pcg32::new(ORDER_SEED, b.kind as u64).shuffle(&mut b.rays);
+        }
+    }
+}
+
+/// Seed stream of the shuffled order.
+const ORDER_SEED: u64 = RAY_SEED ^ 0x5EED;
+
 /// `per_hit` ambient-occlusion rays per hit of `rays` (misses, non-finite hits and zero-area
 /// triangles skipped), grouped by primary ray in the order of `rays`.
 ///
@@ -234,6 +296,29 @@ mod tests {
     fn floor() -> Scene {
         let (a, b, c, d) = (Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y);
         Scene::new(vec![Triangle::new(a, b, c), Triangle::new(a, c, d)]).unwrap()
+    }
+
+    #[test]
+    fn the_orders_hold_the_same_camera_pixels_and_shuffle_only_secondary_rays() {
+        let scene = floor();
+        let key = |r: &Ray| (r.origin.map(f32::to_bits), r.dir.map(f32::to_bits));
+        let morton = RayOrder::Morton.primary_rays(&scene, View::Outside, 8, 6);
+        let mut raster = RayOrder::Raster.primary_rays(&scene, View::Outside, 8, 6);
+        assert_ne!(morton, raster);
+        let mut sorted = morton.clone();
+        sorted.sort_by_key(key);
+        raster.sort_by_key(key);
+        assert_eq!(sorted, raster, "raster and Morton order hold the same camera rays");
+        let hits = vec![Hit { t: 1.0, prim: 0, u: 0.2, v: 0.2 }; morton.len()];
+        let mut batches = batches(&[RayKind::Primary, RayKind::Ao], &scene, &morton, &hits, 2);
+        let before = batches.clone();
+        RayOrder::Shuffled.arrange(&mut batches);
+        assert_eq!(batches[0].rays, before[0].rays, "camera rays keep their order");
+        assert_ne!(batches[1].rays, before[1].rays);
+        let (mut a, mut b) = (batches[1].rays.clone(), before[1].rays.clone());
+        a.sort_by_key(key);
+        b.sort_by_key(key);
+        assert_eq!(a, b, "shuffling keeps the rays");
     }
 
     #[test]

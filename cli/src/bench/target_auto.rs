@@ -3,7 +3,8 @@
 //!
 //! The choice is made on the first trace of a batch, the untimed warm-up, so the timed passes
 //! measure the chosen method alone; what choosing costs is kept and printed with the choice
-//! (BENCHMARKS.md weighs it against the batch's trace time).
+//! (`docs/notes/*-benchmarks-auto.md`, "`auto` against every fixed method", weighs it against the
+//! batch's trace time).
 
 use super::target::{BenchTarget, RaytrailCpu, TargetKind, Work};
 use raytrail::analysis::choice::Choice;

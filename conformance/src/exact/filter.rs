@@ -114,31 +114,51 @@ pub fn filter(ray: &Ray, tri: &Triangle) -> Filtered {
     }
 }
 
-/// The signed distance (in scene units, `f64`) from where `ray` crosses `tri`'s plane to the
-/// triangle's boundary: positive inside, negative outside; `None` for a ray parallel to the
-/// plane or a degenerate triangle. For tolerances, not for decisions.
+/// The signed distance (in scene units, `f64`) across `ray` from its line to `tri`'s boundary:
+/// measured in the plane perpendicular to the ray's direction, positive where the line passes
+/// inside, negative outside; `None` for a ray parallel to the plane or a degenerate triangle.
+/// Across the ray, not in the triangle's plane, because that is where a watertight test errs:
+/// it decides the edges in the ray's own sheared 2D frame (Woop, Benthin & Wald 2013), so its
+/// rounding moves an edge across the ray; a graze stretches that in the plane by `1 / sin`.
+/// For tolerances, not for decisions.
 pub fn margin(ray: &Ray, tri: &Triangle) -> Option<f64> {
     let (o, d) = (v64(ray.origin), v64(ray.dir));
-    let [a, b, c] = tri.v.map(|p| v64(p.to_array()));
-    let (e1, e2, s) = (sub(b, a), sub(c, a), sub(o, a));
-    let nd = d.map(|x| -x);
-    let m = det(e1, e2, nd).v;
-    if m == 0.0 || !m.is_finite() {
-        return None;
-    }
-    let beta = det(s, e2, nd).v / m;
-    let gamma = det(e1, s, nd).v / m;
-    let alpha = 1.0 - beta - gamma;
     let len = |p: V| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-    let cr = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
-    let area2 = len(cr);
-    if area2 == 0.0 {
+    let dn = len(d);
+    if dn == 0.0 || !dn.is_finite() {
         return None;
     }
-    // The distance to the edge opposite a vertex is its barycentric times that vertex's altitude.
-    let h = |edge: V| area2 / len(edge);
-    let m = (alpha * h(sub(c, b))).min(beta * h(e2)).min(gamma * h(e1));
+    let u = d.map(|x| x / dn);
+    let [a, b, c] = tri.v.map(|p| sub(v64(p.to_array()), o));
+    // Each edge's signed double area with the line in the projected plane, and the length of
+    // the projected edge: their ratio is the line's distance from that edge.
+    let edge = |p: V, q: V| (dot(cross(p, q), u), len(cross(sub(q, p), u)));
+    let edges = [edge(b, c), edge(c, a), edge(a, b)];
+    let area = edges.iter().map(|e| e.0).sum::<f64>();
+    if area == 0.0 || !area.is_finite() || edges.iter().any(|e| e.1 == 0.0) {
+        return None;
+    }
+    let m = edges.iter().map(|&(s, l)| area.signum() * s / l).fold(f64::INFINITY, f64::min);
     m.is_finite().then_some(m)
+}
+
+/// The sine of the angle between `ray` and `tri`'s plane (`|cos|` of the angle with its normal):
+/// 1 head-on, towards 0 at a graze; `None` for a degenerate triangle or direction.
+pub fn incidence(ray: &Ray, tri: &Triangle) -> Option<f64> {
+    let d = v64(ray.dir);
+    let [a, b, c] = tri.v.map(|p| v64(p.to_array()));
+    let n = cross(sub(b, a), sub(c, a));
+    let len = |p: V| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+    let s = dot(n, d).abs() / (len(n) * len(d));
+    s.is_finite().then_some(s)
+}
+
+fn cross(p: V, q: V) -> V {
+    [p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]]
+}
+
+fn dot(p: V, q: V) -> f64 {
+    p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
 }
 
 #[cfg(test)]
@@ -156,5 +176,20 @@ mod tests {
         // Nearest edge: the hypotenuse, at (1 - 0.75) / sqrt(2).
         assert!((margin(&down(0.25, 0.5), &tri).unwrap() - 0.25 / 2f64.sqrt()).abs() < 1e-12);
         assert!(margin(&down(2.0, 0.5), &tri).unwrap() < 0.0);
+        assert_eq!(incidence(&down(0.2, 0.2), &tri), Some(1.0));
+    }
+
+    #[test]
+    fn a_graze_shrinks_the_margin_across_the_ray() {
+        // The ray crosses the plane z = 0 at (0.25, 0.25) at a slope of 1 in 100, heading +x:
+        // in the plane the nearest edge is 0.25 away (x = 0 and y = 0), but across the ray the
+        // edge x = 0 is foreshortened by the sine, about 0.01.
+        let tri = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+        let dir = Vec3::new(1.0, 0.0, -0.01);
+        let ray = Ray::new(Vec3::new(0.25, 0.25, 0.0) - dir * 2.0, dir, 0.0, f32::INFINITY);
+        let sine = incidence(&ray, &tri).unwrap();
+        assert!((sine - 0.01 / 1.00005f64.sqrt()).abs() < 1e-6);
+        let m = margin(&ray, &tri).unwrap();
+        assert!((m - 0.25 * sine).abs() < 1e-6, "{m}");
     }
 }

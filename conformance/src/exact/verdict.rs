@@ -4,9 +4,12 @@
 //! passes within rounding distance of an edge it may find the neighbour across that edge, or
 //! nothing at a silhouette. The one tolerance is [`Tolerance`]: `delta`, a distance of
 //! `64 * 2^-24` times the scene's largest coordinate magnitude (the watertight test's own error,
-//! a few ulps of the scene's coordinates, with room to spare), and a `t` tolerance derived from
-//! it. It does not grow with the origin's distance, so a ray from far away must be answered as
-//! accurately as one from inside the scene. A method's answer is:
+//! a few ulps of the scene's coordinates, with room to spare), measured across the ray, where the
+//! watertight test decides (see [`margin`]), and a `t` tolerance derived from it: a shift of
+//! `delta` across the ray moves a triangle's `t` by `delta / sin` of the angle between the ray
+//! and the triangle's plane, so a grazing hit earns a wider `t` window. It does not grow with the
+//! origin's distance, so a ray from far away must be answered as accurately as one from inside
+//! the scene. A method's answer is:
 //! - **exact**: a winner of [`ExactAnswer`] at a `t` within the tolerance, or a miss where the
 //!   ray hits nothing;
 //! - **near**: a triangle the ray passes within `delta` of, at its `t`, where every triangle the
@@ -18,7 +21,7 @@
 //! - **disagreeing**: anything else.
 
 use super::closest::ExactAnswer;
-use super::filter::margin;
+use super::filter::{incidence, margin};
 use raytrail_core::geometry::Triangle;
 use raytrail_core::{Hit, Ray};
 
@@ -38,11 +41,14 @@ impl Tolerance {
         Self { delta: Self::ULPS * f64::from(scene_scale) / 16_777_216.0 }
     }
 
-    /// The `t` tolerance of `ray` around `t`: `delta` along the ray plus `2^-18` of `t` (the
-    /// rounding of `t` itself).
-    pub fn t(&self, ray: &Ray, t: f64) -> f64 {
+    /// The `t` tolerance of `ray` on `tri` around `t`: how far `delta` across the ray moves the
+    /// crossing with `tri`'s plane (`delta / sin` of the angle between them, four times over),
+    /// plus `2^-18` of `t` (the rounding of `t` itself). Infinite for a ray parallel to `tri`,
+    /// whose `t` no shift pins down.
+    pub fn t(&self, ray: &Ray, tri: &Triangle, t: f64) -> f64 {
         let d = ray.dir.iter().fold(0.0f64, |m, x| m.max(f64::from(x.abs())));
-        4.0 * self.delta / d + t.abs() / 262_144.0
+        let sine = incidence(ray, tri).unwrap_or(0.0);
+        4.0 * self.delta / (d * sine) + t.abs() / 262_144.0
     }
 }
 
@@ -105,7 +111,7 @@ pub fn judge(
     }
     let best = exact.t_f64();
     if exact.winners.contains(&hit.prim) {
-        return if (t - best).abs() <= tol.t(ray, best) {
+        return if (t - best).abs() <= tol.t(ray, tri, best) {
             Judgement::Exact
         } else {
             Judgement::Disagree(format!("primitive {} at t = {t:e}, exactly {best:e}", hit.prim))
@@ -113,18 +119,64 @@ pub fn judge(
     }
     let near_p = margin(ray, tri).is_some_and(|m| m >= -tol.delta);
     let pt = plane_t(ray, tri);
-    if !near_p || (pt - t).abs() > tol.t(ray, t) {
+    if !near_p || (pt - t).abs() > tol.t(ray, tri, t) {
         return Judgement::Disagree(format!(
             "primitive {} at t = {t:e}, which the ray does not meet there; exactly {:?} at {best:e}",
             hit.prim, exact.winners
         ));
     }
-    let skipped = exact.hits.iter().filter(|h| h.hi < t - tol.t(ray, t)).find(|h| !marginal(h.prim));
+    // A triangle hit well inside, so far before `t` that its own tolerance cannot bridge the gap,
+    // was skipped.
+    let skipped = exact
+        .hits
+        .iter()
+        .filter(|h| triangles.get(h.prim as usize).is_some_and(|tri| h.hi < t - tol.t(ray, tri, h.hi)))
+        .find(|h| !marginal(h.prim));
     match skipped {
         None => Judgement::Near,
         Some(h) => Judgement::Disagree(format!(
             "primitive {} at t = {t:e}, but primitive {} is hit well inside at t <= {:e}",
             hit.prim, h.prim, h.hi
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::closest::closest_hit;
+    use super::*;
+    use glam::Vec3;
+
+    /// A ray sloping down by `slope` along +x that crosses the plane z = 0 at `(x, 0.25)`.
+    fn graze(x: f32, slope: f32) -> Ray {
+        let dir = Vec3::new(1.0, 0.0, -slope);
+        Ray::new(Vec3::new(x, 0.25, 0.0) - dir * 2.0, dir, 0.0, f32::INFINITY)
+    }
+
+    fn verdict(ray: &Ray, tris: &[Triangle], prim: u32) -> Judgement {
+        let hit = Hit { t: plane_t(ray, &tris[prim as usize]) as f32, prim, u: 0.0, v: 0.0 };
+        judge(ray, tris, &closest_hit(ray, tris), &hit, Tolerance::for_scene(1.0), false)
+    }
+
+    #[test]
+    fn a_graze_is_judged_across_the_ray() {
+        let tris = [Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y)];
+        let (delta, slope) = (Tolerance::for_scene(1.0).delta as f32, 1e-3);
+        assert_eq!(verdict(&graze(0.25, slope), &tris, 0), Judgement::Exact);
+        // Outside the edge x = 0 by half of `delta` across the ray: 500 times that in the plane,
+        // which a rounding across the ray explains.
+        assert_eq!(verdict(&graze(-0.5 * delta / slope, slope), &tris, 0), Judgement::Near);
+        // Four times `delta` across the ray: no rounding explains it.
+        assert!(matches!(verdict(&graze(-4.0 * delta / slope, slope), &tris, 0), Judgement::Disagree(_)));
+    }
+
+    #[test]
+    fn a_grazing_hit_does_not_excuse_skipping_a_face_in_front() {
+        // Face 1 stands across the ray at x = 0.1, head-on; face 0 is grazed behind it.
+        let wall = Triangle::new(Vec3::new(0.1, -1.0, -1.0), Vec3::new(0.1, 2.0, -1.0), Vec3::new(0.1, 0.0, 2.0));
+        let tris = [Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y), wall];
+        let ray = graze(0.25, 1e-3);
+        assert_eq!(verdict(&ray, &tris, 1), Judgement::Exact);
+        assert!(matches!(verdict(&ray, &tris, 0), Judgement::Disagree(_)));
     }
 }

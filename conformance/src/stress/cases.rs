@@ -60,6 +60,26 @@ fn from_afar(tris: &[Triangle], center: Vec3, size: f32, distance: f32, seed: u6
         .collect()
 }
 
+/// Rays aimed exactly at a vertex of a random triangle from 2 to 4 scene sizes away, running
+/// across that triangle nearly in its plane (tilted by `2^-12 .. 2^-4`): a watertight test errs
+/// across the ray, and a graze stretches that error along the face, so these test the verdict's
+/// tolerance model as much as the methods (the Python tests' exact judgement found such rays).
+/// The first is the teapot ray those tests found (vertex 1 of face 4909).
+fn vertex_grazes(tris: &[Triangle], size: f32, seed: u64) -> Vec<Ray> {
+    let mut rng = Pcg32::new(seed, 15);
+    let found = ray(Vec3::new(-9.9667635, 4.953761, 0.5745586), Vec3::new(10.941785, -2.479361, -1.2901136));
+    let grazes = (0..RAYS * 4).filter_map(|i| {
+        let tri = tris[rng.index(tris.len())];
+        let vertex = tri.v[rng.index(3)];
+        let normal = (tri.v[1] - tri.v[0]).cross(tri.v[2] - tri.v[0]).try_normalize()?;
+        let across = ((tri.v[0] + tri.v[1] + tri.v[2]) / 3.0 - vertex).try_normalize()?;
+        let tilt = (2.0f32).powi(-12 + (i % 9) as i32) * if i % 2 == 0 { 1.0 } else { -1.0 };
+        let dir = (across + normal * tilt).try_normalize()?;
+        Some(ray(vertex - dir * (size * rng.range_f32(2.0, 4.0)), dir))
+    });
+    std::iter::once(found).chain(grazes).take(RAYS).collect()
+}
+
 /// Every case, teapot regressions included (the teapot from the scenes folder; an error names
 /// it when missing).
 pub fn all_cases() -> Result<Vec<StressCase>, crate::paths::SceneFileError> {
@@ -205,6 +225,11 @@ pub fn all_cases() -> Result<Vec<StressCase>, crate::paths::SceneFileError> {
             from_afar(&teapot, c, size, d, 800 + k as u64),
         ));
     }
+    out.push(StressCase::new(
+        "teapot, vertex-aimed grazes from 2-4 sizes away",
+        teapot.clone(),
+        vertex_grazes(&teapot, size, 1000),
+    ));
     let big: Vec<Triangle> = teapot.iter().map(|t| Triangle { v: t.v.map(|p| p * 1e11) }).collect();
     out.push(StressCase::new("teapot scaled by 1e11", big.clone(), from_afar(&big, c * 1e11, size * 1e11, 2.0, 900)));
     // The camera's rays (unit directions) into the teapot at 1e37 and 1e-40: `raytrail rays` wrote

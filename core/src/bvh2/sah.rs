@@ -28,7 +28,8 @@ impl Default for SahConfig {
     fn default() -> Self {
         // Per triangle, with both costs 1, leaves held 2.25 triangles on Sponza and every block
         // of four carried empty lanes; costed per block, bvh8 traced the dragon's camera and
-        // diffuse rays 1.35-1.48 times as fast (BENCHMARKS.md, "Leaves costed per block of four").
+        // diffuse rays 1.35-1.48 times as fast
+        // (`docs/notes/*-benchmarks-leaf-cost-and-auto-sample.md`, "Leaves costed per block of four").
         Self { bins: 16, traversal_cost: 1.0, intersection_cost: 1.0, leaf_block: 4, max_leaf_size: 8, max_depth: 63 }
     }
 }

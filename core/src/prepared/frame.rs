@@ -163,9 +163,9 @@ fn box_interval(ray: &Ray, b: &Aabb) -> Option<(f64, f64)> {
 /// exact decision's `reach = scale + max|origin|` by `scale + far` and its `max|d|` from below, so
 /// its slack is finite with room to spare. Only comparisons of single components, no horizontal
 /// maximum and no product: a third of what the filter cost before, and it is run over every ray
-/// of a batch (BENCHMARKS.md, "A cheaper framing filter"). A NaN origin component is never
-/// cleared; a NaN direction component may be, where another is large (untraceable, such a ray is
-/// kept as given anyway).
+/// of a batch (`docs/notes/*-benchmarks-embree-gap.md`, "A cheaper framing filter"). A NaN origin
+/// component is never cleared; a NaN direction component may be, where another is large
+/// (untraceable, such a ray is kept as given anyway).
 #[inline(always)]
 fn surely_kept(ray: &Ray, far: f32, min_dir: f32) -> bool {
     let near = |i: usize| ray.origin[i].abs() <= far;

@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 /// where a separate array of ids costs a load from elsewhere per hit (on the dragon, a likely
 /// miss). Aligned to 32 bytes, a record spans three cache lines wherever it lies (a 144-byte block
 /// at 16-byte alignment spans three or four). 1.02-1.06 on the dragon's rays, 0.99-1.03 on the
-/// interiors' (BENCHMARKS.md, "Triangle blocks that carry their primitive ids").
+/// interiors' (`docs/notes/*-benchmarks-leaf-blocks.md`, "Triangle blocks that carry their primitive ids").
 ///
 /// Byte layout (`repr(C)`, 160 bytes, no padding): `triangles` (144 bytes, [`TriangleBlock`]'s
 /// layout), then `prims` (16 bytes). Lanes without a triangle hold NaN vertices and id

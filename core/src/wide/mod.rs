@@ -45,5 +45,5 @@ pub use tree::{WideBvh, WideStats, WideTree};
 /// Rays per stream of [`ray_stream`] (consecutive rays of a batch, from its start): part of the
 /// rule, since a ray's events depend on the stream it is traced in. Streams of 2048-4096 rays
 /// measured best; at 16,384 the rays' records and lists outgrow a 1 MB L2 and the stream lost
-/// (BENCHMARKS.md, "A ray-stream prototype").
+/// (`docs/notes/*-benchmarks-bvh8-stream.md`, "A ray-stream prototype").
 pub const STREAM_RAYS: usize = 4096;

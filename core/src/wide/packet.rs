@@ -43,8 +43,8 @@ use crate::{Hit, Ray};
 use core::mem::MaybeUninit;
 
 /// Rays per wide packet: four registers of eight lanes on AVX2, and where packets measured best
-/// against single rays on coherent rays (the prototype's 8 to 64 rays: BENCHMARKS.md, "Single-ray
-/// changes that did not pay, and packets that might").
+/// against single rays on coherent rays (the prototype's 8 to 64 rays:
+/// `docs/notes/*-benchmarks-ci-and-single-ray.md`, "Single-ray changes that did not pay").
 pub const WIDE_PACKET: usize = 32;
 
 /// Rays at or below which a packet hands a child over to its rays (see the module docs). A box
@@ -52,7 +52,7 @@ pub const WIDE_PACKET: usize = 32;
 /// per child), where one ray alone tests all its children at once; in the in-process A/B against
 /// the packet without hand-over, 8 beat 2 and 4 on the kitchen's diffuse rays (1.27x against 1.15x
 /// and 1.22x) and gained 1.1-1.5x on Sponza's and the dragon's camera, diffuse and ambient-occlusion
-/// rays (BENCHMARKS.md, "The packet hands thin subtrees to its rays").
+/// rays (`docs/notes/*-benchmarks-hand-over.md`, "The packet hands thin subtrees to its rays").
 pub const HAND_OVER: u32 = 8;
 
 /// The rays of a packet as the box tests read them: per ray (lane), the slab constants and the
@@ -491,7 +491,7 @@ pub fn trace_wide_packets<
         // caller's AVX2 loop only while it stays small: out of line it is not compiled for AVX2,
         // and every kernel call in it stays a call (the instantiations that record enumerations
         // are out of line already). Forcing it in cost camera rays 2-3%; watch its size instead
-        // (BENCHMARKS.md, "A quiet morning's Embree table, and two blocks per pass").
+        // (`docs/notes/*-benchmarks-leaf-blocks.md`, "A quiet morning's Embree table").
         for_each_packet(chunk, WIDE_PACKET, |idx| {
             let mut packet = [Ray { origin: [0.0; 3], tmin: 0.0, dir: [0.0; 3], tmax: 0.0 }; WIDE_PACKET];
             for (k, &i) in idx.iter().enumerate() {

@@ -2,12 +2,12 @@
 //! hits, as soon as the node's box test has named them.
 //!
 //! On a tree far larger than the caches, an incoherent ray waits for memory at every visit, one
-//! miss after another (BENCHMARKS.md, "Prefetching the hit children"). Loading all hit children
-//! at once lets their misses overlap: the first child's while the children are ordered and pushed,
-//! the pushed ones' while the first child's subtree is traversed. Where the previous ray has
-//! already brought the nodes in (a tree that fits the caches, or coherent rays in pixel order) the
-//! hints only cost instructions: shadow rays lost 12-15%. So the CPU backend prefetches only where
-//! [`worth_prefetching`] says so.
+//! miss after another (`docs/notes/*-benchmarks-embree-gap.md`, "Prefetching the hit children").
+//! Loading all hit children at once lets their misses overlap: the first child's while the
+//! children are ordered and pushed, the pushed ones' while the first child's subtree is traversed.
+//! Where the previous ray has already brought the nodes in (a tree that fits the caches, or
+//! coherent rays in pixel order) the hints only cost instructions: shadow rays lost 12-15%. So the
+//! CPU backend prefetches only where [`worth_prefetching`] says so.
 
 use super::leaf_block::LeafBlock;
 use super::memory::{WideMemory, WideSliceMemory};
@@ -33,9 +33,10 @@ pub const PREFETCH_ABOVE_BYTES: usize = 16 << 20;
 /// - Any-hit rays stop at their first occluder, often before the children fetched for them are
 ///   visited. Alone, on the dragon, ambient-occlusion rays gained 2-8% from outside but lost up to
 ///   6% from inside, so they go without. In packets they gained 7-15% from outside and moved by
-///   0.94-1.00 from inside (BENCHMARKS.md, "Prefetching in the packets' handed-over subtrees"); in
-///   streams 1.01-1.03 from outside and 1.00-1.02 from inside (BENCHMARKS.md, "Streams that
-///   prefetch").
+///   0.94-1.00 from inside
+///   (`docs/notes/*-benchmarks-packet-leaves.md`, "Prefetching in the packets' handed-over");
+///   in streams 1.01-1.03 from outside and 1.00-1.02 from inside
+///   (`docs/notes/*-benchmarks-stream-prefetch.md`, "Streams that prefetch").
 /// - Coherence is judged on up to 32 pairs of neighbouring rays spread over the batch: where at
 ///   least a quarter of them point within about 18 degrees of each other (as neighbouring camera
 ///   rays do), the previous ray will have brought the nodes in. Two directions drawn at random over

@@ -21,13 +21,13 @@
 //!   whose own entry distance is still within their interval (the single-ray pop's test) visit
 //!   the child. An entry that no ray reaches is dropped.
 //! - Unlike a packet, a stream hands no subtree to single rays: thin lists stay in the stream
-//!   (handing them over reloaded what the stream had in cache: BENCHMARKS.md, "A ray-stream
-//!   prototype").
+//!   (handing them over reloaded what the stream had in cache:
+//!   `docs/notes/*-benchmarks-bvh8-stream.md`, "A ray-stream prototype").
 //!
 //! Where the memory prefetches ([`WideMemory::PREFETCHES`]: a tree larger than the caches), a
 //! node's hit children are asked for as soon as its box tests have named them, so that their
 //! loads overlap the ordering and the lists: on the 871k-triangle dragon's diffuse rays 1.13-1.21x
-//! (BENCHMARKS.md, "Streams that prefetch").
+//! (`docs/notes/*-benchmarks-stream-prefetch.md`, "Streams that prefetch").
 //!
 //! Closest hits are the single-ray method's bit for bit (every ray still tests every leaf whose
 //! box it enters before its closest hit, and ties go to the smaller primitive id whatever the
@@ -74,7 +74,8 @@ struct StreamScratch<const W: usize, T: TriangleTest, O> {
     /// constants, answer and observer, and its place in the chunk. Kept apart rather than as whole
     /// contexts: a ray's leaves read its triangle constants, made once, rather than the lazily
     /// made copy inside a context that also holds the ray and its slab constants (1.08-1.10x on
-    /// the interiors' diffuse rays: BENCHMARKS.md, "`bvh8-stream` on every backend").
+    /// the interiors' diffuse rays:
+    /// `docs/notes/*-benchmarks-bvh8-stream.md`, "`bvh8-stream` on every backend").
     rays: Vec<StreamRay>,
     tri: Vec<T::PerRay>,
     q: Vec<QueryState>,

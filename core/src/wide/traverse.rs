@@ -98,8 +98,9 @@ impl<const W: usize> WideState<W> {
     /// Traces one ray from `root` to its end: [`WideState::step`] until it is done, or until
     /// `root.max_steps` more steps have been taken, as one loop. The node being visited and the
     /// stack height live in locals rather than in `self` between steps, so they stay in
-    /// registers: 5-15% faster than calling `step` (BENCHMARKS.md, "One loop per ray"). The
-    /// transitions are `step`'s, in its order, so the answer and the events are the same.
+    /// registers: 5-15% faster than calling `step`
+    /// (`docs/notes/*-benchmarks-one-loop.md`, "One loop per ray"). The transitions are `step`'s,
+    /// in its order, so the answer and the events are the same.
     #[inline(always)]
     pub fn run<M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
         &mut self,
@@ -140,10 +141,11 @@ impl<const W: usize> WideState<W> {
 
 /// A postponed child as its slot holds it (the node's words, copied without a branch), decoded
 /// when popped. Decoding it at the push took a branch per pushed child on whether it is an empty
-/// slot, a node or a leaf; pushing the words instead gained 1.5-3% on the interiors (BENCHMARKS.md,
-/// "The wide stack pushes a child's slot words"), likely mispredictions saved on scattered rays
-/// (there were no counters to tell). An empty slot, which no box test hits on an intact tree, is
-/// dropped at the pop before any event, so the events are those of never pushing it.
+/// slot, a node or a leaf; pushing the words instead gained 1.5-3% on the interiors
+/// (`docs/notes/*-benchmarks-packet-leaves.md`, "The wide stack pushes a child's slot words"),
+/// likely mispredictions saved on scattered rays (there were no counters to tell). An empty slot,
+/// which no box test hits on an intact tree, is dropped at the pop before any event, so the events
+/// are those of never pushing it.
 #[derive(Clone, Copy, Debug)]
 struct Postponed {
     child: u32,

@@ -254,8 +254,8 @@ impl<const W: usize> Builder<'_, W> {
     /// surface-area heuristic's estimate of the chance that a ray through a node enters a child
     /// is the child's box area: the largest box is the likeliest to hold an occluder. Against the
     /// binary tree's order this cut bvh8's nodes per shadow ray by 5-60% and made shadow rays
-    /// 1.08-1.70 times as fast (BENCHMARKS.md, "Children largest box first"). Closest-hit queries
-    /// sort by entry distance and meet the slot order only in ties.
+    /// 1.08-1.70 times as fast (`docs/notes/*-benchmarks-one-loop.md`, "Children largest box first").
+    /// Closest-hit queries sort by entry distance and meet the slot order only in ties.
     fn slots(&self, n: u32) -> Vec<u32> {
         let mut c = self.slots_in_tree_order(n);
         // Stable, so equal areas keep the tree's order; areas are finite, so the order is total.

@@ -2,9 +2,11 @@
 //! the `embree3` crate's bindings, behind the `embree` cargo feature.
 //!
 //! The scene is one triangle geometry holding the scene's triangles in file order, each with its
-//! own three vertices (no sharing), so Embree's primitive id is raytrail's. It is built with
-//! Embree's defaults: no scene flags (not `ROBUST`), the default (medium) build quality, on a
-//! device with as many build threads as the bench's largest pool. The build time is that of
+//! own three vertices (no sharing), so Embree's primitive id is raytrail's. It is built with no
+//! scene flags (not `ROBUST`), on a device with as many build threads as the bench's largest
+//! pool, at one of two build qualities, each a peer of its own: `embree`, Embree's default
+//! (medium), and `embree-high` (`RTC_BUILD_QUALITY_HIGH`, spatial splits: what a renderer picks
+//! for a static scene, slower to build and faster to trace). The build time is that of
 //! `rtcCommitScene`; the memory is what Embree's memory monitor reports while the buffers are
 //! made and while the scene is committed.
 //!
@@ -22,7 +24,8 @@ use super::par_trace;
 use crate::bench::report::Built;
 use crate::bench::target::{BenchTarget, TargetKind, Work};
 use embree3::{
-    BufferUsage, Config, Device, Format, GeometryKind, IntersectContext, Ray as EmbreeRay, RayHit, Scene as EmbreeScene,
+    BufferUsage, BuildQuality, Config, Device, Format, GeometryKind, IntersectContext, Ray as EmbreeRay, RayHit,
+    Scene as EmbreeScene,
 };
 use raytrail::core::method::Query;
 use raytrail::core::scene::Scene;
@@ -34,15 +37,50 @@ use std::time::Instant;
 /// Primitive id of an any hit, which Embree's occlusion query does not report.
 pub const UNKNOWN_PRIM: u32 = Hit::REFUSED_PRIM - 1;
 
+/// Embree's build quality, a peer each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quality {
+    /// The default, `RTC_BUILD_QUALITY_MEDIUM`: the peer `embree`.
+    Medium,
+    /// `RTC_BUILD_QUALITY_HIGH` (spatial splits): the peer `embree-high`.
+    High,
+}
+
+impl Quality {
+    /// Both, as the bench names them.
+    pub const ALL: [Quality; 2] = [Quality::Medium, Quality::High];
+
+    /// The peer's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quality::Medium => "embree",
+            Quality::High => "embree-high",
+        }
+    }
+
+    /// The quality of a peer name.
+    pub fn from_name(name: &str) -> Option<Quality> {
+        Self::ALL.into_iter().find(|q| q.name() == name)
+    }
+
+    fn embree(self) -> BuildQuality {
+        match self {
+            Quality::Medium => BuildQuality::MEDIUM,
+            Quality::High => BuildQuality::HIGH,
+        }
+    }
+}
+
 /// An Embree scene over a raytrail scene: a bench target.
 pub struct Embree {
     scene: EmbreeScene<'static>,
+    quality: Quality,
 }
 
 impl Embree {
-    /// Builds the Embree scene over `scene` with `threads` build threads; returns it and what the
-    /// build cost.
-    pub fn new(scene: &Scene, threads: usize) -> Result<(Self, Built), String> {
+    /// Builds the Embree scene over `scene` at `quality` with `threads` build threads; returns it
+    /// and what the build cost.
+    pub fn new(scene: &Scene, threads: usize, quality: Quality) -> Result<(Self, Built), String> {
         let fail = |what: &str, e: embree3::Error| format!("embree: {what}: {e:?}");
         let config = Config { threads: u32::try_from(threads).unwrap_or(0), ..Config::default() };
         let device = Device::with_config(config).map_err(|e| fail("cannot create a device", e))?;
@@ -77,6 +115,7 @@ impl Embree {
         let buffer_bytes = allocated.load(Ordering::Relaxed);
         let geometry = geometry.commit();
         let mut embree = device.create_scene().map_err(|e| fail("cannot create a scene", e))?;
+        embree.set_build_quality(quality.embree());
         embree.attach_geometry(&geometry);
         let before_commit = allocated.load(Ordering::Relaxed);
         let start = Instant::now();
@@ -92,8 +131,11 @@ impl Embree {
             .into_iter()
             .map(|(what, n)| (what.to_string(), usize::try_from(n).unwrap_or(0)))
             .collect();
-        let built = Built { what: "embree (default quality, rtcCommitScene)".to_string(), seconds, bytes };
-        Ok((Self { scene: embree }, built))
+        let what = match quality {
+            Quality::Medium => "embree (default quality, rtcCommitScene)",
+            Quality::High => "embree-high (RTC_BUILD_QUALITY_HIGH, rtcCommitScene)",
+        };
+        Ok((Self { scene: embree, quality }, Built { what: what.to_string(), seconds, bytes }))
     }
 
     /// Closest hit of one ray (`rtcIntersect1`).
@@ -122,7 +164,7 @@ impl Embree {
 
 impl BenchTarget for Embree {
     fn name(&self) -> &str {
-        "embree"
+        self.quality.name()
     }
 
     fn kind(&self) -> TargetKind {
@@ -166,14 +208,23 @@ mod tests {
     }
 
     #[test]
-    fn embree_agrees_with_the_stack_method() {
+    fn embree_agrees_with_the_stack_method_at_both_qualities() {
+        for quality in Quality::ALL {
+            agrees_with_the_stack_method(quality);
+        }
+        assert_eq!(Quality::from_name("embree-high"), Some(Quality::High));
+        assert_eq!(Quality::from_name("embree-low"), None);
+    }
+
+    fn agrees_with_the_stack_method(quality: Quality) {
         let named = builtin_scene();
         let scene = &named.scene;
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-        let (embree, built) = Embree::new(scene, 2).unwrap();
+        let (embree, built) = Embree::new(scene, 2, quality).unwrap();
         assert!(built.seconds >= 0.0);
         assert!(built.bytes.iter().all(|(_, n)| *n > 0), "{:?}", built.bytes);
-        assert_eq!(embree.name(), "embree");
+        assert_eq!(embree.name(), quality.name());
+        assert!(built.what.starts_with(quality.name()));
 
         let rays = primary(scene, 64, 48);
         let expected = stack_hits(scene, &rays, Query::Closest);

@@ -6,7 +6,7 @@
 //! apart. The watertight variants also keep raytrail's closest-hit tie rule (equal `t`: smaller
 //! primitive id) and its inclusive interval, so their hits can match raytrail's bit for bit.
 //!
-//! Embree (with the `embree` cargo feature) is traced with its own test only: its traversal takes
+//! Embree (`embree` and `embree-high`, with the `embree` cargo feature) is traced with its own test only: its traversal takes
 //! no per-triangle callback short of a user geometry, which would not be Embree's fast path.
 
 mod bvh_crate;
@@ -50,16 +50,17 @@ pub fn build(names: &[String], scene: &Scene, pool: &rayon::ThreadPool) -> Resul
     let mut targets: Targets = Vec::new();
     let mut built = Vec::new();
     for name in names {
+        #[cfg(feature = "embree")]
+        if let Some(quality) = embree::Quality::from_name(name) {
+            let (target, b) = embree::Embree::new(scene, pool.current_num_threads(), quality)?;
+            targets.push(Box::new(target));
+            built.push(b);
+            continue;
+        }
         let b = match name.as_str() {
             "obvhs-bvh2" => both_variants(name, pool.install(|| obvhs::ObvhsScene::bvh2(scene)), &mut targets),
             "obvhs-cwbvh" => both_variants(name, pool.install(|| obvhs::ObvhsScene::cwbvh(scene)), &mut targets),
             "bvh" => both_variants(name, pool.install(|| bvh_crate::BvhScene::new(scene)), &mut targets),
-            #[cfg(feature = "embree")]
-            "embree" => {
-                let (target, built) = embree::Embree::new(scene, pool.current_num_threads())?;
-                targets.push(Box::new(target));
-                built
-            }
             other => return Err(format!("unknown peer '{other}'")),
         };
         built.push(b);
@@ -70,10 +71,15 @@ pub fn build(names: &[String], scene: &Scene, pool: &rayon::ThreadPool) -> Resul
 /// The target names a peer adds: its own test and, where it has one, the watertight variant.
 pub fn target_names(peer: &str) -> Vec<String> {
     let mut names = vec![peer.to_string()];
-    if peer != "embree" {
+    if !is_embree(peer) {
         names.push(format!("{peer}{}", Variant::Watertight.suffix()));
     }
     names
+}
+
+/// Whether `peer` names Embree (at either build quality), which has only its own test.
+pub fn is_embree(peer: &str) -> bool {
+    matches!(peer, "embree" | "embree-high")
 }
 
 /// Adds the two targets of a built peer tree (its own test, then raytrail's watertight one);

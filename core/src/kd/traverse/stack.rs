@@ -60,8 +60,9 @@ impl KdStackState {
     }
 
     /// [`KdStackState::step`] until it is done, or until `max_steps` more steps have been taken,
-    /// as one loop with the cursor in locals (BENCHMARKS.md, "One loop per ray"): the same
-    /// transitions in the same order, so the same answer and events.
+    /// as one loop with the cursor in locals
+    /// (`docs/notes/*-benchmarks-one-loop.md`, "One loop per ray"): the same transitions in the
+    /// same order, so the same answer and events.
     #[inline(always)]
     pub fn run<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
         &mut self,
