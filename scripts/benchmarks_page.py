@@ -18,6 +18,8 @@ import os
 import re
 import sys
 
+from check_citations import markdown_headings  # the same heading rule as the citation check
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RESULTS = "docs/results"
 PAGE = "BENCHMARKS.md"
@@ -40,21 +42,10 @@ def resolve_note(star):
     return f"{folder}/{matches[0]}"
 
 
-def headings(path):
-    out, fenced = [], False
-    with open(os.path.join(ROOT, path), encoding="utf-8") as f:
-        for line in f:
-            if line.startswith("```"):
-                fenced = not fenced
-            elif not fenced and line.startswith("#"):
-                out.append(line.lstrip("#").strip())
-    return out
-
-
 def source_link(src):
     path = resolve_note(src["note"])
     section = src["section"]
-    if not any(h.lower().startswith(section.lower()) for h in headings(path)):
+    if not any(h.lower().startswith(section.lower()) for h in markdown_headings(path)):
         raise SourceError(f'{src["note"]}: no heading starts with "{section}"')
     return f'[`{src["note"]}`]({path}), "{section}"'
 

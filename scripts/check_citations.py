@@ -28,6 +28,19 @@ import sys
 import tokenize
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def markdown_headings(path):
+    """The heading titles of the Markdown file `path` (relative to the repository), outside code
+    fences, in order."""
+    out, fenced = [], False
+    with open(os.path.join(ROOT, path), encoding="utf-8") as f:
+        for line in f:
+            if line.startswith("```"):
+                fenced = not fenced
+            elif not fenced and line.startswith("#"):
+                out.append(line.lstrip("#").strip())
+    return out
 SKIP_PREFIXES = ("docs/notes/",)
 NOTES_INDEX = "docs/notes/README.md"  # the index is checked; the dated notes are not
 EXTENSIONS = {".rs": "slash", ".wgsl": "slash", ".py": "python", ".sh": "hash", ".md": "markdown"}
@@ -154,17 +167,10 @@ class Repo:
 
     def heading_list(self, path):
         if path not in self.headings:
-            out, fenced = [], False
             try:
-                with open(os.path.join(ROOT, path), encoding="utf-8") as f:
-                    for line in f:
-                        if line.startswith("```"):
-                            fenced = not fenced
-                        elif not fenced and line.startswith("#"):
-                            out.append(line.lstrip("#").strip())
+                self.headings[path] = markdown_headings(path)
             except (OSError, UnicodeDecodeError):
-                pass
-            self.headings[path] = out
+                self.headings[path] = []
         return self.headings[path]
 
     def has_heading(self, path, title):

@@ -235,15 +235,8 @@ macro_rules! conformance_suite {
         );
     };
     (@cases $run:expr) => {
+        $crate::conformance_suite!(@small $run);
         $crate::conformance_suite!(@each $run;
-            shared_edge_grid => SharedEdgeGrid,
-            sphereflake => Sphereflake,
-            triangle_soup => TriangleSoup,
-            degenerate_stack_needs_and_uses_64_bit_keys => DegenerateStack,
-            far_from_origin => FarFromOrigin,
-            tiny_cases => TinyCases,
-            cornell_box => Mesh("cornell_box.obj"),
-            teapot => Mesh("teapot.obj"),
             kitchen => Mesh("kitchen.obj"),
             sponza => Mesh("sponza.obj"),
             bunny => Mesh("bunny.obj"),
