@@ -155,3 +155,16 @@ fn div_rn(a: f32, b: f32) -> f32 {
 fn div_rn3(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(div_rn(a.x, b.x), div_rn(a.y, b.y), div_rn(a.z, b.z));
 }
+
+// A float's bits as an unsigned integer in the floats' order (negatives below positives, `-0`
+// just below `+0`), so that `atomicMin` over the integers takes the least float; the packet and
+// stream walks keep each child's least entry distance this way.
+fn order_bits(t: f32) -> u32 {
+    let b = bitcast<u32>(t);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
+// The float whose `order_bits` are `k`.
+fn from_order_bits(k: u32) -> f32 {
+    return bitcast<f32>(select(~k, k & 0x7fffffffu, (k & 0x80000000u) != 0u));
+}

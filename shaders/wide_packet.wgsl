@@ -22,7 +22,7 @@
 override WORKGROUP_SIZE: u32 = 64u;
 
 const WP_STACK_SIZE: u32 = (WIDE_W - 1u) * 64u;
-// `wp_ordered(+inf)`: the key of a child no ray hits.
+// `order_bits(+inf)`: the key of a child no ray hits.
 const WP_KEY_NONE: u32 = 0xff800000u;
 // What the current step does: visit WP_CUR, or check which rays of a popped entry reach it.
 const WP_VISIT: u32 = 1u;
@@ -52,16 +52,6 @@ var<workgroup> WP_KEYS: array<atomic<u32>, WIDE_W>;
 var<workgroup> WP_T_HI: array<f32, WIDE_PACKET>;
 // The leading invocation's copy of the rays per hit slot.
 var<private> WP_RAYS: array<u32, WIDE_W>;
-
-// Float bits as an unsigned integer in the floats' order, for `atomicMin`.
-fn wp_ordered(t: f32) -> u32 {
-    let b = bitcast<u32>(t);
-    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
-}
-
-fn wp_unordered(k: u32) -> f32 {
-    return bitcast<f32>(select(~k, k & 0x7fffffffu, (k & 0x80000000u) != 0u));
-}
 
 // After a ray's leaf test or handed-over subtree (`each_alone`): an answered ray leaves the
 // packet, the others narrow their box interval to their closest hit.
@@ -103,7 +93,7 @@ fn wp_lane(lane: u32) {
     for (var i = 0u; i < WIDE_W; i = i + 1u) {
         if (mask & (1u << i)) != 0u {
             atomicOr(&WP_HITS[i], bit);
-            atomicMin(&WP_KEYS[i], wp_ordered(WT_T[i]));
+            atomicMin(&WP_KEYS[i], order_bits(WT_T[i]));
         }
     }
 }
@@ -168,7 +158,7 @@ fn wp_lead() {
     var mask = 0u;
     for (var i = 0u; i < WIDE_W; i = i + 1u) {
         let rays = atomicLoad(&WP_HITS[i]);
-        let key = wp_unordered(atomicLoad(&WP_KEYS[i]));
+        let key = from_order_bits(atomicLoad(&WP_KEYS[i]));
         atomicStore(&WP_HITS[i], 0u);
         atomicStore(&WP_KEYS[i], WP_KEY_NONE);
         WP_RAYS[i] = rays;

@@ -33,7 +33,7 @@ const WS_WORDS: u32 = WIDE_STREAM / 32u;
 // `traverse::WIDE_STACK`.
 const WS_STACK_SIZE: u32 = (WIDE_W - 1u) * 64u;
 const WS_NONE: u32 = 0xffffffffu;
-// `ws_ordered(+inf)`: the key of a child no ray hits.
+// `order_bits(+inf)`: the key of a child no ray hits.
 const WS_KEY_NONE: u32 = 0xff800000u;
 // What the current step does: visit WS_CUR, copy the sets of an expanded node, or check which rays
 // of a popped entry reach its child.
@@ -82,21 +82,11 @@ var<workgroup> WS_STEPS: u32;
 // The current set, and per child the rays that hit it; word w written by invocation w alone.
 var<workgroup> WS_LIVE: array<u32, WS_WORDS>;
 var<workgroup> WS_HITS: array<array<u32, WS_WORDS>, WIDE_W>;
-// Per child, its least entry distance (`ws_ordered`); the children hit; whether a check found rays.
+// Per child, its least entry distance (`order_bits`); the children hit; whether a check found rays.
 var<workgroup> WS_KEYS: array<atomic<u32>, WIDE_W>;
 var<workgroup> WS_SEEN: atomic<u32>;
 var<workgroup> WS_ANY: atomic<u32>;
 var<private> WS_STREAM_INDEX: u32;
-
-// Float bits as an unsigned integer in the floats' order, for `atomicMin`.
-fn ws_ordered(t: f32) -> u32 {
-    let b = bitcast<u32>(t);
-    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
-}
-
-fn ws_unordered(k: u32) -> f32 {
-    return bitcast<f32>(select(~k, k & 0x7fffffffu, (k & 0x80000000u) != 0u));
-}
 
 // Where set `e`'s word `w` lies in the scratch, and word `i` of the saved state.
 fn ws_list_word(e: u32, w: u32) -> u32 {
@@ -141,7 +131,7 @@ fn ws_visit(w: u32) {
         for (var i = 0u; i < WIDE_W; i = i + 1u) {
             if (mask & (1u << i)) != 0u {
                 sets[i] = sets[i] | (1u << b);
-                keys[i] = min(keys[i], ws_ordered(WT_T[i]));
+                keys[i] = min(keys[i], order_bits(WT_T[i]));
             }
         }
     }
@@ -262,7 +252,7 @@ fn ws_next() {
     // `sort_keys` over the stream's keys, as `wide_test` leaves them for one ray.
     let mask = atomicExchange(&WS_SEEN, 0u);
     for (var i = 0u; i < WIDE_W; i = i + 1u) {
-        let key = ws_unordered(atomicExchange(&WS_KEYS[i], WS_KEY_NONE));
+        let key = from_order_bits(atomicExchange(&WS_KEYS[i], WS_KEY_NONE));
         let hit = (mask & (1u << i)) != 0u;
         WT_T[i] = select(bitcast<f32>(0x7f800000u), key, hit);
         WT_SLOT[i] = select(i + WIDE_W, i, hit);

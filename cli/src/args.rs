@@ -1,72 +1,14 @@
-//! The command line's flags, declared with clap (derive), and the mesh loading that `--strict`
-//! and `--prim-map` shape, shared by the commands that take `--scene`.
-//!
-//! Usage errors (clap's, and the checks [`Failure::Usage`] carries) exit with status 2; failures
-//! while working exit with status 1.
+//! The command line's commands and their flags, declared with clap (derive), and the mesh loading
+//! that `--strict` and `--prim-map` shape, shared by the commands that take `--scene` (flags
+//! several commands share are in [`crate::flags`]; why a command fails, in [`crate::failure`]).
 
-use clap::builder::PossibleValuesParser;
+use crate::failure::{usage, Failure};
+use crate::flags::{method_names_or_auto, LoadFlags, AUTO, BUILDERS, BUILTIN_SCENE, STRICT};
 use clap::{Parser, Subcommand};
-use raytrail::core::method::Method;
 use raytrail::mesh::{write_sources_csv, LoadOptions, LoadReport};
 use raytrail::Builder;
 use raytrail_conformance::NamedScene;
 use std::path::Path;
-
-/// The `--scene` name of the built-in scene: the conformance suite's sphereflake (25,220
-/// triangles), generated, so that the main job needs no file.
-pub const BUILTIN_SCENE: &str = "builtin";
-
-/// The switch that makes mesh loading strict (`run`, `trace`, `rays`, `bench`, `render`): an
-/// element that is not a triangle or polygon (a face of fewer than three vertices, an OBJ line or
-/// point, a glTF line or point primitive) fails the load instead of being skipped with a warning.
-pub const STRICT: &str = "strict";
-
-/// Why a command did not finish: a usage error (exit status 2) or a failure while working (1).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Failure {
-    /// The command line asks for something impossible: nothing was done.
-    Usage(String),
-    /// The work failed (a file that does not load, a write that fails, ...).
-    Run(String),
-}
-
-impl Failure {
-    /// The exit status of this failure.
-    pub fn code(&self) -> i32 {
-        match self {
-            Failure::Usage(_) => 2,
-            Failure::Run(_) => 1,
-        }
-    }
-
-    /// The message.
-    pub fn message(&self) -> &str {
-        match self {
-            Failure::Usage(m) | Failure::Run(m) => m,
-        }
-    }
-}
-
-impl From<String> for Failure {
-    fn from(m: String) -> Self {
-        Failure::Run(m)
-    }
-}
-
-impl From<&str> for Failure {
-    fn from(m: &str) -> Self {
-        Failure::Run(m.to_string())
-    }
-}
-
-/// What a command returns: its exit status when it finished (0, or 1 for a failed conformance
-/// check), or why it did not.
-pub type Outcome = Result<i32, Failure>;
-
-/// A usage error.
-pub fn usage<T>(m: impl Into<String>) -> Result<T, Failure> {
-    Err(Failure::Usage(m.into()))
-}
 
 const AFTER_HELP: &str = "\
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
@@ -238,58 +180,6 @@ pub struct AccuracyArgs {
     pub max_rays: u64,
     #[command(flatten)]
     pub load: LoadFlags,
-}
-
-/// The mesh loading flags.
-#[derive(clap::Args, Debug, Clone, PartialEq, Eq)]
-pub struct LoadFlags {
-    /// Fail on mesh elements that are not triangles or polygons instead of skipping them
-    #[arg(long)]
-    pub strict: bool,
-    /// Largest size a gzip-compressed mesh may inflate to, in bytes
-    #[arg(long, value_name = "BYTES", default_value_t = LoadOptions::DEFAULT_MAX_INFLATED)]
-    pub max_mesh_bytes: u64,
-}
-
-impl Default for LoadFlags {
-    /// The defaults the command line has.
-    fn default() -> Self {
-        LoadFlags { strict: false, max_mesh_bytes: LoadOptions::DEFAULT_MAX_INFLATED }
-    }
-}
-
-impl LoadFlags {
-    /// The mesh loading policy of [`STRICT`].
-    pub fn load_options(&self) -> LoadOptions {
-        LoadOptions { strict: self.strict, max_inflated: self.max_mesh_bytes, ..LoadOptions::default() }
-    }
-}
-
-/// The BVH2 builders by command-line name.
-pub const BUILDERS: [&str; 3] = [Builder::ALL[0].name(), Builder::ALL[1].name(), Builder::ALL[2].name()];
-
-/// The name that asks for the method to be chosen by timing candidates on a sample of the rays
-/// (`raytrail::analysis`).
-pub const AUTO: &str = "auto";
-
-/// The method names and [`AUTO`], for `--method` where a method can be chosen.
-pub fn method_names_or_auto() -> PossibleValuesParser {
-    PossibleValuesParser::new(std::iter::once(AUTO).chain(Method::ALL.map(Method::name)))
-}
-
-/// A `--method` value: a fixed method, or `None` for [`AUTO`].
-pub fn method_or_auto(name: &str) -> Option<Method> {
-    (name != AUTO).then(|| method(name))
-}
-
-/// The builder of a name that clap has checked.
-pub fn builder(name: &str) -> Builder {
-    Builder::from_name(name).unwrap_or_default()
-}
-
-/// The method of a name that clap has checked.
-pub fn method(name: &str) -> Method {
-    Method::from_name(name).expect("clap checks the method name")
 }
 
 /// `raytrail run`.
@@ -556,6 +446,7 @@ pub fn write_prim_map(out: &str, scene: &str, report: &LoadReport) -> Result<(),
 #[cfg(test)]
 mod tests {
     use super::*;
+    use raytrail::core::method::Method;
 
     fn args(s: &str) -> LoadFlags {
         let cli =

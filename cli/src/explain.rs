@@ -1,9 +1,11 @@
 //! `raytrail explain SCENE [--rays FILE]`: what the scene needs (the analysis of
 //! `raytrail::analysis`), as a table and optionally JSON.
 
-use crate::args::{builder, check_input, check_output, load_scene, warn, ExplainArgs, Outcome};
+use crate::args::{check_input, check_output, load_scene, warn, ExplainArgs};
 use crate::bench::rays::{batches, primary_rays, RayKind};
 use crate::bench::view::{Enclosure, ViewChoice};
+use crate::failure::Outcome;
+use crate::flags::builder;
 use crate::limits::{check_count, check_image};
 use crate::progress::{timed, Progress};
 use raytrail::analysis::{analyze, RaySet, SceneAnalysis};
@@ -31,7 +33,7 @@ pub fn main(a: ExplainArgs) -> Outcome {
     } else {
         check_image(a.width, a.height, "rays per set", "max-rays", a.max_rays, 48)?;
     }
-    let view = ViewChoice::from_name(&a.view).map_err(crate::args::Failure::Usage)?;
+    let view = ViewChoice::from_name(&a.view).map_err(crate::failure::Failure::Usage)?;
     let builder = builder(&a.builder);
     let (loaded, _) = timed(&format!("loading {}", a.scene), || load_scene(&a.scene, &a.load.load_options()));
     let (named, _, warning) = loaded?;

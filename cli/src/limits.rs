@@ -1,7 +1,7 @@
 //! Limits on sizes that come from the command line or from input files, checked before anything
 //! that large is allocated: exceeding one is a clear error rather than an aborted process.
 
-use crate::args::Failure;
+use crate::failure::Failure;
 
 /// Default most rays of one set (`--max-rays`): 2^26 rays are 2 GiB of rays and 1 GiB of hits.
 pub const DEFAULT_MAX_RAYS: u64 = 1 << 26;

@@ -7,6 +7,8 @@ mod args;
 mod auto;
 mod bench;
 mod explain;
+mod failure;
+mod flags;
 mod gpu;
 mod limits;
 mod median;

@@ -3,9 +3,11 @@
 //! triangles' normals, ambient occlusion, or a heat map of the traversal work per pixel (nodes
 //! visited by `--method`, from its per-ray node enumeration), so methods can be compared by eye.
 
-use crate::args::{builder, check_input, check_output, load_scene, method_or_auto, warn, Outcome, RenderArgs};
+use crate::args::{check_input, check_output, load_scene, warn, RenderArgs};
 use crate::bench::rays::{facing_normal, AoShape};
 use crate::bench::view::View;
+use crate::failure::Outcome;
+use crate::flags::{builder, method_or_auto};
 use crate::limits::{check_image, try_vec};
 use crate::progress::timed;
 use crate::trace::raster_rays;
@@ -38,7 +40,7 @@ pub fn main(a: RenderArgs) -> Outcome {
     let method = method_or_auto(&a.method);
     let heat = a.mode == "heat" || a.mode == "backtracks";
     if heat && a.backend == "gpu" {
-        return crate::args::usage(format!(
+        return crate::failure::usage(format!(
             "--mode {} runs on the CPU (the work per ray is recorded there): leave out --backend gpu",
             a.mode
         ));

@@ -2,7 +2,9 @@
 //! report speed, work per ray, state size, hash-table figures, what `--method auto` picks per ray
 //! set, and the conformance verdict.
 
-use crate::args::{builder, check_input, load_scene, warn, Outcome, RunArgs};
+use crate::args::{check_input, load_scene, warn, RunArgs};
+use crate::failure::Outcome;
+use crate::flags::builder;
 use crate::limits::check_image;
 use crate::median::median;
 use crate::progress::{timed, Progress};

@@ -3,7 +3,8 @@
 //! tiny triangles beside huge ones, the edges of the supported range) with every method, each ray
 //! judged against the exact reference; per case and method: rays, agreeing, refused, disagreeing.
 
-use crate::args::{Failure, Outcome, StressArgs};
+use crate::args::StressArgs;
+use crate::failure::{Failure, Outcome};
 use crate::progress::Progress;
 use raytrail::core::method::Method;
 use raytrail::core::trace::Trace;

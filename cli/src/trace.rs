@@ -1,7 +1,9 @@
 //! `raytrail trace` and `raytrail rays`: NumPy files in and out.
 
-use crate::args::{builder, check_input, check_output, load_scene, method_or_auto, warn, write_prim_map, Outcome};
+use crate::args::{check_input, check_output, load_scene, warn, write_prim_map};
 use crate::args::{RaysArgs, TraceArgs};
+use crate::failure::Outcome;
+use crate::flags::{builder, method_or_auto};
 use crate::limits::{check_count, check_image, try_vec};
 use crate::progress::timed;
 use raytrail::core::method::Query;

@@ -1,16 +1,19 @@
-//! The one-loop forms of the wide and kd-stack traversals (`WideState::run`, `KdStackState::run`:
-//! what the CPU backend traces with) against their state machines driven step by step (`step`:
-//! what the simulator and the embedded example drive): the same answer and the same events, ray
-//! for ray, also when the step budget cuts a ray short.
+//! The one-loop overrides of [`Machine::run`] (the wide stack and trail walks, the kd stack: what
+//! the CPU backend traces with) against the same states driven step by step by [`drive`] (what the
+//! default `run` and the simulator do): the same answer and the same events, ray for ray, also
+//! when the step budget cuts a ray short.
 
 use raytrail_core::bvh2::NodeRef;
+use raytrail_core::hash::PerfectHash;
 use raytrail_core::intersect::{KdRayContext, NoPair, Watertight};
 use raytrail_core::kd::traverse::{scene_interval, KdRoot, KdStackState};
 use raytrail_core::kd::{KdBuilder, KdSliceMemory};
 use raytrail_core::method::{Collapse, Query};
 use raytrail_core::observe::{Backtrack, Counters, Observer};
-use raytrail_core::traverse::{begin, Step};
-use raytrail_core::wide::traverse::{WideRoot, WideState};
+use raytrail_core::traverse::{begin, drive, Machine, QueryState};
+use raytrail_core::wide::keyed::{keyed_nodes, WideHashedMemory};
+use raytrail_core::wide::trail::WideTrailState;
+use raytrail_core::wide::traverse::WideState;
 use raytrail_core::wide::{FastKernel, ReferenceKernel, WideBvh};
 use raytrail_core::Ray;
 
@@ -58,25 +61,55 @@ fn rays(n: usize, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
+/// Traces `ray` with `fresh()` once through its [`Machine::run`] and once through [`drive`] (the
+/// one step loop), and checks the same answer and the same events. Returns the nodes visited.
+fn run_equals_drive<Mem: ?Sized, Ctx, S: Machine<Mem, Ctx>>(
+    fresh: impl Fn() -> S,
+    mem: &Mem,
+    ctx: &Ctx,
+    q0: QueryState,
+    max_steps: u32,
+    what: &dyn core::fmt::Debug,
+) -> u64 {
+    let (mut q_step, mut q_run) = (q0, q0);
+    let (mut e_step, mut e_run) = (Events::default(), Events::default());
+    drive(&mut fresh(), mem, ctx, &mut q_step, &mut e_step, max_steps);
+    fresh().run(mem, ctx, &mut q_run, &mut e_run, max_steps);
+    let bits = |h: raytrail_core::Hit| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits());
+    assert_eq!(bits(q_run.hit), bits(q_step.hit), "{what:?}");
+    assert_eq!(e_run, e_step, "{what:?}");
+    e_run.counters.internal_nodes + e_run.counters.leaves
+}
+
 fn compare<const W: usize, K: raytrail_core::wide::ChildKernel>(wide: &WideBvh<W>, scale: f32, max_steps: u32) -> u64 {
     let mem = wide.memory();
-    let root = WideRoot { root: wide.root(), scene_scale: scale, max_steps };
+    let root = wide.root();
     let mut visited = 0;
     for (i, ray) in rays(1500, 11 + W as u64).iter().enumerate() {
         let query = if i % 2 == 0 { Query::Closest } else { Query::Any };
         let Some((ctx, q0)) = begin::<Watertight, NoPair>(ray, scale, query) else { continue };
-        let (mut q_step, mut q_run) = (q0, q0);
-        let (mut e_step, mut e_run) = (Events::default(), Events::default());
-        let mut state = WideState::<W>::new(root.root);
-        let mut budget = max_steps;
-        while state.step::<_, Watertight, K, _>(&mem, &ctx, &mut q_step, &mut e_step) != Step::Done && budget > 0 {
-            budget -= 1;
-        }
-        WideState::<W>::new(root.root).run::<_, Watertight, K, _>(&mem, root, &ctx, &mut q_run, &mut e_run);
-        let bits = |h: raytrail_core::Hit| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits());
-        assert_eq!(bits(q_run.hit), bits(q_step.hit), "ray {i}: {ray:?}");
-        assert_eq!(e_run, e_step, "ray {i}: {ray:?}");
-        visited += e_run.counters.internal_nodes + e_run.counters.leaves;
+        visited += run_equals_drive(|| WideState::<W, K>::new(root), &mem, &ctx, q0, max_steps, &(i, ray));
+    }
+    visited
+}
+
+/// [`compare`] for the stackless wide walk over the tree's perfect hash.
+fn compare_trail<const W: usize>(wide: &WideBvh<W>, scale: f32, max_steps: u32) -> u64 {
+    let (entries, _) = keyed_nodes(wide).unwrap();
+    let (tables, _) = PerfectHash::build(&entries, wide.nodes().len()).unwrap();
+    let mem = WideHashedMemory {
+        tree: wide.memory(),
+        displacement: &tables.displacement,
+        cells: &tables.cells,
+        shape: tables.shape,
+    };
+    let root = wide.root();
+    let mut visited = 0;
+    for (i, ray) in rays(1500, 31 + W as u64).iter().enumerate() {
+        let query = if i % 2 == 0 { Query::Closest } else { Query::Any };
+        let Some((ctx, q0)) = begin::<Watertight, NoPair>(ray, scale, query) else { continue };
+        let fresh = || WideTrailState::<W, u64, FastKernel>::new(root);
+        visited += run_equals_drive(fresh, &mem, &ctx, q0, max_steps, &(i, ray));
     }
     visited
 }
@@ -90,6 +123,15 @@ fn run_equals_stepping_the_state_machine() {
             + compare::<8, ReferenceKernel>(&w8, scale, max_steps);
         // The rays do reach into the tree (a budget of 0 still visits each root).
         assert!(visited > 3 * 1000, "budget {max_steps}: only {visited} nodes visited");
+    }
+}
+
+#[test]
+fn trail_run_equals_stepping_the_state_machine() {
+    let (scale, w4, w8) = wide_soup(4000, 7, Collapse::PullUp);
+    for max_steps in [u32::MAX, 0, 1, 3, 10] {
+        let visited = compare_trail(&w4, scale, max_steps) + compare_trail(&w8, scale, max_steps);
+        assert!(visited > 2 * 1000, "budget {max_steps}: only {visited} nodes visited");
     }
 }
 
@@ -108,18 +150,7 @@ fn kd_stack_run_equals_stepping_the_state_machine() {
             let Some((ctx, q0)) = begin::<Watertight, NoPair>(ray, scale, query) else { continue };
             let ctx: KdRayContext<Watertight> = ctx;
             let Some((t0, t1)) = scene_interval(&ctx, &root) else { continue };
-            let (mut q_step, mut q_run) = (q0, q0);
-            let (mut e_step, mut e_run) = (Events::default(), Events::default());
-            let mut state = KdStackState::new(t0, t1);
-            let mut budget = max_steps;
-            while state.step(&mem, &ctx, &mut q_step, &mut e_step) != Step::Done && budget > 0 {
-                budget -= 1;
-            }
-            KdStackState::new(t0, t1).run(&mem, &ctx, &mut q_run, &mut e_run, max_steps);
-            let bits = |h: raytrail_core::Hit| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits());
-            assert_eq!(bits(q_run.hit), bits(q_step.hit), "ray {i}: {ray:?}");
-            assert_eq!(e_run, e_step, "ray {i}: {ray:?}");
-            visited += e_run.counters.internal_nodes + e_run.counters.leaves;
+            visited += run_equals_drive(|| KdStackState::new(t0, t1), &mem, &ctx, q0, max_steps, &(i, ray));
         }
         // The rays do reach into the tree (a budget of 0 still visits each ray's first node).
         assert!(visited > 500, "budget {max_steps}: only {visited} nodes visited");

@@ -1,24 +1,27 @@
 use crate::chunk::Chunk;
 use rayon::prelude::*;
-use raytrail_core::kd::traverse::packets::PACKET_CHUNK;
 use raytrail_core::method::Method;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
+use raytrail_core::traverse::packets::GROUPING_RAYS;
 use raytrail_core::wide::STREAM_RAYS;
 use raytrail_core::{Error, Hit, Ray};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Rays per parallel task: large enough to amortize scheduling, small enough to balance load; the
-/// packet grouping's chunk, so that packets never span two tasks; for a stream method, one stream,
-/// so that each task traces a whole one.
+/// Rays per parallel task: large enough to amortize scheduling, small enough to balance load, and
+/// one packet-grouping span, so that packets never cross two tasks.
+const TASK_RAYS: usize = GROUPING_RAYS;
+
+/// Rays per parallel task for `method`: [`TASK_RAYS`], or for a stream method one stream, so that
+/// each task traces a whole one.
 fn chunk_rays(method: Method) -> usize {
     if method.wide().is_some_and(|m| m.streams()) {
         STREAM_RAYS
     } else {
-        PACKET_CHUNK
+        TASK_RAYS
     }
 }
 
@@ -117,7 +120,7 @@ impl CpuBackend {
             let mut untraceable = 0;
             if framing == Framing::Check {
                 let (needs_framing, n) = self.install(|| {
-                    rays.par_chunks(PACKET_CHUNK)
+                    rays.par_chunks(TASK_RAYS)
                         .map(|c| scene.0.check_rays(c))
                         .fold(|| (false, 0), |(f, n), c| (f | c.needs_framing, n + c.untraceable))
                         .reduce(|| (false, 0), |a, b| (a.0 | b.0, a.1 + b.1))

@@ -1,15 +1,17 @@
 //! The BVH2 methods' loop for one chunk, monomorphized per key width x triangle test x recording.
 
 use crate::chunk::Chunk;
-use raytrail_core::bvh2::traverse::{trace_batch, trace_ray, TraceRoot};
+use crate::record::{record, with_test, Independent, RayLoop, WithTest};
+use core::marker::PhantomData;
+use raytrail_core::bvh2::traverse::{trace_batch, TraceRoot};
 use raytrail_core::bvh2::SliceMemory;
-use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
+use raytrail_core::intersect::TriangleTest;
 use raytrail_core::key::{Key, KeyWidth};
-use raytrail_core::method::{Bvh2Method, Method};
-use raytrail_core::observe::{Both, Counters, NoObserver, Recorder};
+use raytrail_core::method::{Bvh2Method, Method, Query};
+use raytrail_core::observe::{Counters, Observer};
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
-use raytrail_core::Error;
+use raytrail_core::trace::TraceOptions;
+use raytrail_core::{Error, Hit, Ray};
 
 /// Traces one chunk with `method`; returns its counters (only `rays` is set when nothing is
 /// recorded).
@@ -19,45 +21,48 @@ pub(crate) fn trace_chunk(
     opts: &TraceOptions,
     chunk: Chunk<'_>,
 ) -> Result<Counters, Error> {
-    let run = Run { scene, method, opts, mem: scene.memory(method)?, root: scene.root(method)? };
-    match (scene.key_width(), opts.triangle_test) {
-        (KeyWidth::W32, TriangleTestKind::Watertight) => run.go::<u32, Watertight>(chunk),
-        (KeyWidth::W32, TriangleTestKind::MollerTrumbore) => run.go::<u32, MollerTrumbore>(chunk),
-        (KeyWidth::W64, TriangleTestKind::Watertight) => run.go::<u64, Watertight>(chunk),
-        (KeyWidth::W64, TriangleTestKind::MollerTrumbore) => run.go::<u64, MollerTrumbore>(chunk),
+    let (mem, root) = (scene.memory(method)?, scene.root(method)?);
+    let run = Run { scene, method, opts, mem, root, chunk };
+    match scene.key_width() {
+        KeyWidth::W32 => with_test(opts.triangle_test, Keyed::<u32>(run, PhantomData)),
+        KeyWidth::W64 => with_test(opts.triangle_test, Keyed::<u64>(run, PhantomData)),
     }
 }
 
-struct Run<'a> {
+/// What a chunk is traced with.
+struct Run<'a, 'c> {
     scene: &'a PreparedScene,
     method: Bvh2Method,
     opts: &'a TraceOptions,
     mem: SliceMemory<'a>,
     root: TraceRoot,
+    chunk: Chunk<'c>,
 }
 
-impl Run<'_> {
-    fn go<K: Key, T: TriangleTest>(&self, chunk: Chunk<'_>) -> Result<Counters, Error> {
-        let (method, query) = (self.method, self.opts.query);
-        let mut counters = Counters::default();
-        match self.opts.record {
-            Record::Nothing => {
-                trace_batch::<K, _, T, _>(method, &self.mem, self.root, chunk.rays, chunk.hits, query, &mut NoObserver);
-            }
-            Record::Counters => {
-                trace_batch::<K, _, T, _>(method, &self.mem, self.root, chunk.rays, chunk.hits, query, &mut counters);
-            }
-            Record::Enumerations => {
-                let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());
-                for ((ray, hit), nodes) in slots {
-                    let mut obs = Both(counters, Recorder::default());
-                    *hit = trace_ray::<K, _, T, _>(method, &self.mem, self.root, ray, query, &mut obs);
-                    counters = obs.0;
-                    *nodes = self.scene.canonical_ids(Method::Bvh2(method), obs.1.nodes.iter().copied())?;
-                }
-            }
-        }
-        counters.rays = chunk.rays.len() as u64;
-        Ok(counters)
+/// [`Run`] with the key width `K`, waiting for its triangle test.
+struct Keyed<'a, 'c, K>(Run<'a, 'c>, PhantomData<K>);
+
+impl<K: Key> WithTest for Keyed<'_, '_, K> {
+    type Output = Result<Counters, Error>;
+    fn with<T: TriangleTest>(self) -> Self::Output {
+        let Run { scene, method, opts, mem, root, chunk } = self.0;
+        let batch = Batch::<K, T> { method, mem, root, query: opts.query, types: PhantomData };
+        record(scene, Method::Bvh2(method), opts.record, chunk, &Independent(&batch))
+    }
+}
+
+/// The batch loop over a slice of rays ([`trace_batch`]).
+struct Batch<'a, K, T> {
+    method: Bvh2Method,
+    mem: SliceMemory<'a>,
+    root: TraceRoot,
+    query: Query,
+    types: PhantomData<(K, T)>,
+}
+
+impl<K: Key, T: TriangleTest> RayLoop for Batch<'_, K, T> {
+    #[inline(always)]
+    fn trace<O: Observer>(&self, rays: &[Ray], hits: &mut [Hit], obs: &mut O) {
+        trace_batch::<K, _, T, _>(self.method, &self.mem, self.root, rays, hits, self.query, obs);
     }
 }

@@ -3,14 +3,14 @@
 //! AVX2 (as the stack traversal's, so the two compare on equal terms).
 
 use crate::chunk::Chunk;
-use crate::wide::{record_rays, RayLoop};
+use crate::record::{record, with_test, Independent, RayLoop, WithTest};
 use core::marker::PhantomData;
-use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
+use raytrail_core::intersect::TriangleTest;
 use raytrail_core::key::{Key, KeyWidth};
-use raytrail_core::method::{Query, WideMethod};
+use raytrail_core::method::{Method, Query, WideMethod};
 use raytrail_core::observe::{Counters, Observer};
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::trace::{TraceOptions, TriangleTestKind};
+use raytrail_core::trace::TraceOptions;
 use raytrail_core::wide::keyed::WideKeyedMemory;
 use raytrail_core::wide::trail::trace_wide_trail_batch;
 use raytrail_core::wide::traverse::WideRoot;
@@ -25,29 +25,29 @@ pub(crate) fn trace_chunk(
     chunk: Chunk<'_>,
 ) -> Result<Counters, Error> {
     let (mem, keys) = scene.wide_keyed(method)?;
+    let (mem, test) = (&mem, opts.triangle_test);
     match keys {
-        KeyWidth::W32 => by_test::<u32, _>(scene, method, opts, &mem, chunk),
-        KeyWidth::W64 => by_test::<u64, _>(scene, method, opts, &mem, chunk),
+        KeyWidth::W32 => with_test(test, ByTest::<u32, _> { scene, method, opts, mem, chunk, key: PhantomData }),
+        KeyWidth::W64 => with_test(test, ByTest::<u64, _> { scene, method, opts, mem, chunk, key: PhantomData }),
     }
 }
 
-fn by_test<K: Key, M: WideKeyedMemory<4>>(
-    scene: &PreparedScene,
+/// A keyed chunk waiting for its triangle test.
+struct ByTest<'a, 'm, 'c, K, M> {
+    scene: &'a PreparedScene,
     method: WideMethod,
-    opts: &TraceOptions,
-    mem: &M,
-    chunk: Chunk<'_>,
-) -> Result<Counters, Error> {
-    let (root, query) = (scene.wide_root(method)?, opts.query);
-    match opts.triangle_test {
-        TriangleTestKind::Watertight => {
-            let b = KeyedBatch::<4, K, M, Watertight> { mem, root, query, types: PhantomData };
-            record_rays(scene, method, opts.record, chunk, &b)
-        }
-        TriangleTestKind::MollerTrumbore => {
-            let b = KeyedBatch::<4, K, M, MollerTrumbore> { mem, root, query, types: PhantomData };
-            record_rays(scene, method, opts.record, chunk, &b)
-        }
+    opts: &'a TraceOptions,
+    mem: &'m M,
+    chunk: Chunk<'c>,
+    key: PhantomData<K>,
+}
+
+impl<K: Key, M: WideKeyedMemory<4>> WithTest for ByTest<'_, '_, '_, K, M> {
+    type Output = Result<Counters, Error>;
+    fn with<T: TriangleTest>(self) -> Self::Output {
+        let ByTest { scene, method, opts, mem, chunk, .. } = self;
+        let b = KeyedBatch::<4, K, M, T> { mem, root: scene.wide_root(method)?, query: opts.query, types: PhantomData };
+        record(scene, Method::Wide(method), opts.record, chunk, &Independent(&b))
     }
 }
 
@@ -63,9 +63,9 @@ impl<const W: usize, K: Key, M: WideKeyedMemory<W>, T: TriangleTest> RayLoop for
     fn trace<O: Observer>(&self, rays: &[Ray], hits: &mut [Hit], obs: &mut O) {
         let (mem, root, query) = (self.mem, self.root, self.query);
         #[cfg(target_arch = "x86_64")]
-        if crate::avx::available() {
+        if crate::x86::available() {
             // SAFETY: the processor has AVX2 (checked just above).
-            unsafe { crate::avx::trace_keyed_batch::<W, K, M, T, O>(mem, root, rays, hits, query, obs) };
+            unsafe { crate::x86::single_ray::trace_keyed_batch::<W, K, M, T, O>(mem, root, rays, hits, query, obs) };
             return;
         }
         trace_wide_trail_batch::<W, K, M, T, FastKernel, O>(mem, root, rays, hits, query, obs);

@@ -6,23 +6,18 @@
 //! path carries no observer at all.
 #![warn(missing_docs)]
 
-#[cfg(target_arch = "x86_64")]
-mod avx;
-#[cfg(target_arch = "x86_64")]
-mod avx_packet;
-#[cfg(target_arch = "x86_64")]
-mod avx_packet_begin;
-#[cfg(target_arch = "x86_64")]
-mod avx_packet_leaf;
 mod backend;
 mod bvh2;
 mod chunk;
 mod kd;
 mod keyed;
+mod record;
 mod stream;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod test_rng;
 mod wide;
+#[cfg(target_arch = "x86_64")]
+mod x86;
 
 pub use backend::{CpuBackend, CpuScene};
 /// Why [`CpuBackend::with_threads`] could not make its pool (rayon's error).

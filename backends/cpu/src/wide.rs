@@ -6,13 +6,13 @@
 //! packet loop, only the subtrees handed over to single rays prefetch).
 
 use crate::chunk::Chunk;
+use crate::record::{record, with_test, Independent, RayLoop, Shared, SharedWalks, WithTest};
 use core::marker::PhantomData;
-use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
-use raytrail_core::method::Query;
-use raytrail_core::method::{Method, WideMethod};
-use raytrail_core::observe::{Both, Counters, NoObserver, Observer, Recorder};
+use raytrail_core::intersect::TriangleTest;
+use raytrail_core::method::{Method, Query, WideMethod};
+use raytrail_core::observe::{Counters, Observer};
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
+use raytrail_core::trace::TraceOptions;
 use raytrail_core::wide::packet::{trace_wide_packets, ReferencePacketKernel};
 use raytrail_core::wide::ray_stream::trace_wide_streams;
 use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
@@ -56,57 +56,30 @@ impl WideRun<'_> {
     }
 
     fn test<const W: usize, M: WideMemory<W>>(&self, mem: &M, chunk: Chunk<'_>) -> Result<Counters, Error> {
-        match self.opts.triangle_test {
-            TriangleTestKind::Watertight => self.run::<W, M, Watertight>(mem, chunk),
-            TriangleTestKind::MollerTrumbore => self.run::<W, M, MollerTrumbore>(mem, chunk),
-        }
-    }
-
-    fn run<const W: usize, M: WideMemory<W>, T: TriangleTest>(
-        &self,
-        mem: &M,
-        chunk: Chunk<'_>,
-    ) -> Result<Counters, Error> {
-        let (root, query) = (self.root, self.opts.query);
-        if self.method.shares_walks() {
-            let streams = self.method.streams();
-            return self.run_shared(chunk, &SharedWalk::<W, M, T> { mem, root, query, streams, test: PhantomData });
-        }
-        let stack = StackBatch::<W, M, T> { mem, root, query, test: PhantomData };
-        record_rays(self.scene, self.method, self.opts.record, chunk, &stack)
-    }
-
-    /// [`WideRun::run`] for a method whose rays share walks of the tree (packets, streams): each
-    /// ray's observer comes back from the walk.
-    fn run_shared(&self, chunk: Chunk<'_>, walks: &impl SharedWalks) -> Result<Counters, Error> {
-        let mut counters = Counters::default();
-        match self.opts.record {
-            Record::Nothing => walks.trace::<NoObserver>(chunk.rays, chunk.hits, &mut |_, _| {}),
-            Record::Counters => walks.trace::<Counters>(chunk.rays, chunk.hits, &mut |_, c| counters.add(&c)),
-            Record::Enumerations => {
-                let mut failed = None;
-                let slots = &mut *chunk.enumerations;
-                walks.trace::<Both<Counters, Recorder>>(chunk.rays, chunk.hits, &mut |i, o| {
-                    counters.add(&o.0);
-                    match self.scene.canonical_ids(Method::Wide(self.method), o.1.nodes.iter().copied()) {
-                        Ok(ids) => slots[i] = ids,
-                        Err(e) => failed = Some(e),
-                    }
-                });
-                if let Some(e) = failed {
-                    return Err(e);
-                }
-            }
-        }
-        counters.rays = chunk.rays.len() as u64;
-        Ok(counters)
+        with_test(self.opts.triangle_test, ByTest::<W, M> { run: self, mem, chunk })
     }
 }
 
-/// A loop over a chunk whose rays share walks of the tree, generic over what observes each ray.
-trait SharedWalks {
-    /// Traces `rays` into `hits`, handing each ray's index and observer to `done`.
-    fn trace<O: Observer + Default>(&self, rays: &[Ray], hits: &mut [Hit], done: &mut impl FnMut(usize, O));
+/// A [`WideRun`] over memory `M`, waiting for its triangle test.
+struct ByTest<'r, 'm, 'c, const W: usize, M> {
+    run: &'r WideRun<'r>,
+    mem: &'m M,
+    chunk: Chunk<'c>,
+}
+
+impl<const W: usize, M: WideMemory<W>> WithTest for ByTest<'_, '_, '_, W, M> {
+    type Output = Result<Counters, Error>;
+    fn with<T: TriangleTest>(self) -> Self::Output {
+        let ByTest { run, mem, chunk } = self;
+        let (root, query, method) = (run.root, run.opts.query, run.method);
+        let (scene, record_what) = (run.scene, run.opts.record);
+        if method.shares_walks() {
+            let walks = SharedWalk::<W, M, T> { mem, root, query, streams: method.streams(), test: PhantomData };
+            return record(scene, Method::Wide(method), record_what, chunk, &Shared(&walks));
+        }
+        let stack = StackBatch::<W, M, T> { mem, root, query, test: PhantomData };
+        record(scene, Method::Wide(method), record_what, chunk, &Independent(&stack))
+    }
 }
 
 /// The packet loop ([`packets`]) or, with `streams`, the stream loop ([`streams`]).
@@ -126,40 +99,6 @@ impl<const W: usize, M: WideMemory<W>, T: TriangleTest> SharedWalks for SharedWa
             packets::<W, M, T, O>(self.mem, self.root, rays, hits, self.query, done);
         }
     }
-}
-
-/// One loop over a slice of rays, generic over what observes it (so one recording routine serves
-/// the stack and the keyed traversals).
-pub(crate) trait RayLoop {
-    /// Traces `rays` into `hits`, reporting to `obs`.
-    fn trace<O: Observer>(&self, rays: &[Ray], hits: &mut [Hit], obs: &mut O);
-}
-
-/// Traces a chunk ray by ray with `rays`, observing what `record` asks for: nothing, counters,
-/// or each ray's enumeration in canonical node ids.
-pub(crate) fn record_rays(
-    scene: &PreparedScene,
-    method: WideMethod,
-    record: Record,
-    chunk: Chunk<'_>,
-    rays: &impl RayLoop,
-) -> Result<Counters, Error> {
-    let mut counters = Counters::default();
-    match record {
-        Record::Nothing => rays.trace(chunk.rays, chunk.hits, &mut NoObserver),
-        Record::Counters => rays.trace(chunk.rays, chunk.hits, &mut counters),
-        Record::Enumerations => {
-            let slots = chunk.rays.iter().zip(chunk.hits.iter_mut()).zip(chunk.enumerations.iter_mut());
-            for ((ray, hit), nodes) in slots {
-                let mut obs = Both(counters, Recorder::default());
-                rays.trace(core::slice::from_ref(ray), core::slice::from_mut(hit), &mut obs);
-                counters = obs.0;
-                *nodes = scene.canonical_ids(Method::Wide(method), obs.1.nodes.iter().copied())?;
-            }
-        }
-    }
-    counters.rays = chunk.rays.len() as u64;
-    Ok(counters)
 }
 
 /// The stack traversal's loop ([`batch`]).
@@ -188,9 +127,9 @@ fn packets<const W: usize, M: WideMemory<W>, T: TriangleTest, O: Observer + Defa
     done: impl FnMut(usize, O),
 ) {
     #[cfg(target_arch = "x86_64")]
-    if crate::avx::available() {
+    if crate::x86::available() {
         // SAFETY: the processor has AVX2 (checked just above).
-        unsafe { crate::avx_packet::trace_batch::<W, M, T, O>(mem, root, rays, hits, query, done) };
+        unsafe { crate::x86::packet::trace_batch::<W, M, T, O>(mem, root, rays, hits, query, done) };
         return;
     }
     trace_wide_packets::<W, M, T, FastKernel, ReferencePacketKernel, O>(mem, root, rays, hits, query, done);
@@ -208,9 +147,9 @@ fn streams<const W: usize, M: WideMemory<W>, T: TriangleTest, O: Observer + Defa
     done: impl FnMut(usize, O),
 ) {
     #[cfg(target_arch = "x86_64")]
-    if crate::avx::available() {
+    if crate::x86::available() {
         // SAFETY: the processor has AVX2 (checked just above).
-        unsafe { crate::avx::trace_streams::<W, M, T, O>(mem, root, rays, hits, query, done) };
+        unsafe { crate::x86::stream::trace_streams::<W, M, T, O>(mem, root, rays, hits, query, done) };
         return;
     }
     trace_wide_streams::<W, M, T, FastKernel, O>(mem, root, rays, hits, query, done);
@@ -229,9 +168,9 @@ fn batch<const W: usize, M: WideMemory<W>, T: TriangleTest, O: Observer>(
     obs: &mut O,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if crate::avx::available() {
+    if crate::x86::available() {
         // SAFETY: the processor has AVX2 (checked just above).
-        unsafe { crate::avx::trace_batch::<W, M, T, O>(mem, root, rays, hits, query, obs) };
+        unsafe { crate::x86::single_ray::trace_batch::<W, M, T, O>(mem, root, rays, hits, query, obs) };
         return;
     }
     trace_wide_batch::<W, M, T, FastKernel, O>(mem, root, rays, hits, query, obs);

@@ -8,7 +8,7 @@ use crate::pipelines::Pipelines;
 use crate::record;
 use crate::scene::WgpuScene;
 use crate::stream::kernels::StreamKernels;
-use crate::workspace::{HIT_BYTES, RAY_BYTES};
+use crate::workspace::bytes_moved;
 use raytrail_core::bvh2::NodeRef;
 use raytrail_core::method::Method;
 use raytrail_core::observe::Counters;
@@ -138,12 +138,6 @@ impl WgpuBackend {
         arranged.restore(&out.records, stride, &mut records);
         Ok(batch::StreamOut { records, gpu_seconds: out.gpu_seconds })
     }
-}
-
-/// Bytes a trace of `rays` rays moves between host and device: rays up, hits and `stride` record
-/// words per ray down.
-pub(crate) fn bytes_moved(rays: usize, stride: usize) -> u64 {
-    rays as u64 * (RAY_BYTES + HIT_BYTES + 4 * stride as u64)
 }
 
 /// Canonical ids of one ray's recorded references, by the core's convention.

@@ -7,10 +7,11 @@
 //!   disjoint-interval mask.
 
 use crate::config::Dispatch;
+use crate::stream::shared_parts::{stream_header, INTERSECT_OWN, STREAM_COMMON};
 use raytrail_core::intersect::{FAR_PAD, REFINE_SCALE, RELIABLE_LIMIT, SLACK_SCALE};
 use raytrail_core::kd::traverse::{PACKET_WIDTH, SHORT_STACK_MAX};
 use raytrail_core::key::KeyWidth;
-use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query};
+use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query, WideMethod};
 use raytrail_core::trace::{Record, TriangleTestKind};
 use raytrail_core::Error;
 
@@ -162,8 +163,14 @@ impl Variant {
             Method::Wide(m) if m.streams() => &[WIDE, WIDE_RAY_STREAM],
             Method::Wide(m) if m.keyed() => &[WIDE, keys, HASH, WIDE_TRAIL],
             Method::Wide(_) => &[WIDE, WIDE_STACK],
-            // Its stages are kernels of their own (crate::stream); this is the one that traces.
-            Method::Stream(_) => return crate::stream::compose::StreamKernel::Intersect(*self).parts(),
+            // Its stages are kernels of their own (crate::stream); this is the one that traces:
+            // the 8-wide tree's files without work items or dispatch, then the stream's own.
+            Method::Stream(_) => {
+                let mut parts = Variant { method: Method::Wide(WideMethod::Bvh8), ..*self }.method_parts()?;
+                parts.push(STREAM_COMMON);
+                parts.extend_from_slice(&INTERSECT_OWN);
+                return Ok(parts);
+            }
             other => return Err(Error::Unsupported { method: other.name(), by: "the wgpu backend" }),
         };
         parts.extend_from_slice(method);
@@ -172,10 +179,10 @@ impl Variant {
 
     /// The full WGSL source: the generated constants, then the parts.
     pub fn source(&self) -> Result<String, Error> {
-        if let Method::Stream(_) = self.method {
-            return crate::stream::compose::StreamKernel::Intersect(*self).source();
-        }
         let mut s = constants_header(self.method);
+        if let Method::Stream(_) = self.method {
+            s.push_str(&stream_header());
+        }
         for (name, text) in self.parts()? {
             s.push_str(&format!("\n// ---- shaders/{name} ----\n"));
             s.push_str(text);

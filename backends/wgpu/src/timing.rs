@@ -3,11 +3,12 @@
 //! leave its idle clocks. A trace call's own figures ([`Report`](raytrail_core::trace::Report))
 //! are the end-to-end ones.
 
-use crate::backend::{bytes_moved, WgpuBackend};
+use crate::backend::WgpuBackend;
 use crate::batch::{self, Launch, Stamps};
 use crate::device::{device_error, Gpu};
 use crate::launch::{self, Arranged};
 use crate::scene::WgpuScene;
+use crate::workspace::bytes_moved;
 use crate::workspace::{SlotNeeds, Workspace};
 use raytrail_core::method::Method;
 use raytrail_core::trace::{Record, Trace, TraceOptions};

@@ -11,6 +11,12 @@ use std::collections::HashMap;
 pub(crate) const RAY_BYTES: u64 = 32;
 pub(crate) const HIT_BYTES: u64 = 16;
 
+/// Bytes a trace of `rays` rays moves between host and device: rays up, hits and `stride` record
+/// words per ray down.
+pub(crate) fn bytes_moved(rays: usize, stride: usize) -> u64 {
+    rays as u64 * (RAY_BYTES + HIT_BYTES + 4 * stride as u64)
+}
+
 /// One batch's buffers. A slot is reused only after its previous batch has been read back.
 pub(crate) struct Slot {
     pub uniform: wgpu::Buffer,

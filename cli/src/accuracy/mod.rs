@@ -17,9 +17,10 @@ pub mod classify;
 mod plot;
 mod report;
 
-use crate::args::{check_input, check_output, AccuracyArgs, Failure, Outcome};
+use crate::args::{check_input, check_output, AccuracyArgs};
 use crate::bench::rays::{self, RayKind};
 use crate::bench::view::{Enclosure, View};
+use crate::failure::{Failure, Outcome};
 use crate::median::median;
 use crate::progress::{timed, Progress};
 use classify::{classify, Tally};
@@ -126,7 +127,7 @@ fn plan(a: &AccuracyArgs) -> Result<Plan, Failure> {
         tests,
         views,
         auto_view,
-        builder: crate::args::builder(&a.builder),
+        builder: crate::flags::builder(&a.builder),
         load: a.load.load_options(),
         width: a.width,
         height: a.height,

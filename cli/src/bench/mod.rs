@@ -23,7 +23,8 @@ mod target_auto;
 mod target_gpu;
 pub mod view;
 
-use crate::args::{check_input, check_output, Failure, Outcome};
+use crate::args::{check_input, check_output};
+use crate::failure::{Failure, Outcome};
 use crate::progress::{timed, Progress};
 use options::Options;
 use raytrail::core::bvh2::SahConfig;
@@ -100,7 +101,7 @@ pub fn main(a: options::BenchArgs, args: &[String]) -> Outcome {
 fn check_baseline(opts: &Options) -> Result<(), String> {
     let mut names: Vec<String> = opts.methods.iter().map(|m| m.name().to_string()).collect();
     if opts.auto {
-        names.push(crate::args::AUTO.to_string());
+        names.push(crate::flags::AUTO.to_string());
     }
     for p in &opts.peers {
         names.extend(peers::target_names(p));
@@ -255,7 +256,7 @@ fn print_auto_choices(
         let (report, threads) = (reports.get(i / pools.len().max(1)), pools.get(i % pools.len().max(1)).map(|p| p.0));
         let report = report.filter(|r| r.rays == n);
         let batch_s = report
-            .and_then(|r| r.rows.iter().find(|row| row.target == crate::args::AUTO && Some(row.threads) == threads))
+            .and_then(|r| r.rows.iter().find(|row| row.target == crate::flags::AUTO && Some(row.threads) == threads))
             .map_or(f64::NAN, |row| row.median_s);
         let kind = report.map_or("?", |r| r.kind.name());
         println!(

@@ -3,8 +3,8 @@
 use super::rays::RayKind;
 use super::rays::RayOrder;
 use super::view::ViewChoice;
-use crate::args::BUILTIN_SCENE;
-use crate::args::{LoadFlags, AUTO, BUILDERS};
+use crate::flags::BUILTIN_SCENE;
+use crate::flags::{LoadFlags, AUTO, BUILDERS};
 use clap::Parser;
 use raytrail::core::method::Method;
 use raytrail::core::stream::{StreamParams, MAX_PACKET};

@@ -60,7 +60,7 @@ impl AutoTarget {
 
 impl BenchTarget for AutoTarget {
     fn name(&self) -> &str {
-        crate::args::AUTO
+        crate::flags::AUTO
     }
 
     fn kind(&self) -> TargetKind {

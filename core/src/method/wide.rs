@@ -163,7 +163,7 @@ impl WideMethod {
     /// Per-ray state in bytes for a wide tree of `depth` levels: node address, current entry
     /// distance, stack pointer, and `width - 1` entries of (node, entry distance) per level. A
     /// packet's node, mask and stack (entries of node, ray mask and key) are shared by its
-    /// [`WIDE_PACKET`](crate::wide::packet::WIDE_PACKET) rays; each ray adds its box interval, and
+    /// [`WIDE_PACKET`](crate::wide::WIDE_PACKET) rays; each ray adds its box interval, and
     /// the single-ray state it needs when the packet hands it a subtree. A stream's stack holds
     /// at most `width - 1` entries per level (node and list bounds), and each ray is in at most
     /// that many lists (its index and entry distance), with its slab constants, interval and
@@ -182,7 +182,7 @@ impl WideMethod {
             let own = core::mem::size_of::<crate::intersect::SlabRay>() + 8 + 16;
             8 * entries + own + shared.div_ceil(crate::wide::STREAM_RAYS)
         } else if self.packets() {
-            let rays = crate::wide::packet::WIDE_PACKET;
+            let rays = crate::wide::WIDE_PACKET;
             let shared = 8 + 8 + 4 + 16 * (self.width() - 1) * depth as usize;
             8 + shared.div_ceil(rays) + self.single_ray_bytes(depth)
         } else {

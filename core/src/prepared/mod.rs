@@ -16,7 +16,7 @@ use crate::hash::{keys_to_hash, HashCoverage, HashShape, HashStats, PerfectHash}
 use crate::kd::traverse::KdRoot;
 use crate::kd::{KdBuilder, KdSliceMemory, KdTree};
 use crate::key::KeyWidth;
-use crate::method::{Bvh2Method, Method, StreamMethod, Structure, WideMethod, WideTreeKind};
+use crate::method::{Bvh2Method, Method, StreamMethod, WideMethod, WideTreeKind};
 use crate::scene::Scene;
 use crate::stream::{LevelBvh, StreamScene};
 use crate::wide::keyed::{keyed_nodes, WideHashedMemory};
@@ -24,6 +24,9 @@ use crate::wide::traverse::WideRoot;
 use crate::wide::{WideBvh, WideSliceMemory, WideTree};
 use crate::Error;
 use alloc::vec::Vec;
+
+/// A wide tree the scene may hold, or why building it failed.
+type WideResult<const W: usize> = Result<Option<WideBvh<W>>, Error>;
 
 /// Seconds spent deriving each part (zero without the `std` feature, which has the clock).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -141,16 +144,12 @@ impl PreparedScene {
         let tris = scene.triangles();
         let mut timings = PrepareTimings::default();
         let t0 = seconds_since(None);
-        // Only the BVH2 methods other than parent/sibling read the uncle layout (and the hash
-        // tables are built over it); a scene traced only by kd, wide or stream methods skips it.
-        let needs_uncles = methods.iter().any(|m| m.bvh2().is_some_and(|b| !b.needs_parent_links()));
-        let uncles =
-            if needs_uncles { Some(BinaryLayout::new(&bvh, tris, LinkKind::Uncles)) } else { None }.transpose()?;
-        let parents = if methods.iter().any(|m| m.needs_parent_links()) {
-            Some(BinaryLayout::new(&bvh, tris, LinkKind::ParentSibling)).transpose()?
-        } else {
-            None
-        };
+        // Exactly the parts the methods read (`Part::of`), and nothing else.
+        let needs = |part: Part| part.needed_by(methods);
+        let layout =
+            |part: Part, links: LinkKind| needs(part).then(|| BinaryLayout::new(&bvh, tris, links)).transpose();
+        let uncles = layout(Part::UncleLayout, LinkKind::Uncles)?;
+        let parents = layout(Part::ParentLayout, LinkKind::ParentSibling)?;
         timings.layouts = seconds_since(Some(t0));
         let build = |coverage: HashCoverage| -> Result<BuiltHash, Error> {
             let layout = uncles.as_ref().ok_or(Error::NotPrepared { method: "hash", missing: "the uncle layout" })?;
@@ -161,14 +160,13 @@ impl PreparedScene {
             Ok(BuiltHash { tables, stats })
         };
         let t1 = seconds_since(None);
-        let hash = if methods.iter().any(|m| m.needs_hash()) { Some(build(HashCoverage::Backtracking)?) } else { None };
+        let hash = needs(Part::Hash).then(|| build(HashCoverage::Backtracking)).transpose()?;
         timings.hash = seconds_since(Some(t1));
         let t2 = seconds_since(None);
-        let full_hash =
-            if methods.iter().any(|m| m.needs_full_hash()) { Some(build(HashCoverage::All)?) } else { None };
+        let full_hash = needs(Part::FullHash).then(|| build(HashCoverage::All)).transpose()?;
         timings.full_hash = seconds_since(Some(t2));
         let t3 = seconds_since(None);
-        let kd = if methods.iter().any(|m| m.structure() == Structure::Kd) {
+        let kd = if needs(Part::Kd) {
             let tree = KdBuilder::default().build(tris)?;
             Some(PreparedKd { tree, triangles: tris.to_vec(), short_stack: 3 })
         } else {
@@ -176,26 +174,18 @@ impl PreparedScene {
         };
         timings.kd = seconds_since(Some(t3));
         let t4 = seconds_since(None);
-        let wants = |w: WideMethod| methods.contains(&Method::Wide(w));
-        let wants_tree = |k: WideTreeKind| methods.iter().any(|m| m.wide().is_some_and(|w| w.tree() == k));
-        let (wide4, wide8, wide4_naive, wide8_sah) = (
-            wants_tree(WideTreeKind::Four)
-                .then(|| WideBvh::build(&bvh, tris, WideTreeKind::Four.collapse()))
-                .transpose()?,
-            wants_tree(WideTreeKind::Eight)
-                .then(|| WideBvh::build(&bvh, tris, WideTreeKind::Eight.collapse()))
-                .transpose()?,
-            wants_tree(WideTreeKind::FourNaive)
-                .then(|| WideBvh::build(&bvh, tris, WideTreeKind::FourNaive.collapse()))
-                .transpose()?,
-            wants_tree(WideTreeKind::EightSah)
-                .then(|| WideBvh::build(&bvh, tris, WideTreeKind::EightSah.collapse()))
-                .transpose()?,
-        );
+        // A generic function, since a closure cannot be generic over the width.
+        fn wide<const W: usize>(needed: bool, bvh: &Bvh2, tris: &[Triangle], kind: WideTreeKind) -> WideResult<W> {
+            needed.then(|| WideBvh::build(bvh, tris, kind.collapse())).transpose()
+        }
+        let wide4 = wide(needs(Part::Wide4), &bvh, tris, WideTreeKind::Four)?;
+        let wide8 = wide(needs(Part::Wide8), &bvh, tris, WideTreeKind::Eight)?;
+        let wide4_naive = wide(needs(Part::Wide4Naive), &bvh, tris, WideTreeKind::FourNaive)?;
+        let wide8_sah = wide(needs(Part::Wide8Sah), &bvh, tris, WideTreeKind::EightSah)?;
         timings.wide = seconds_since(Some(t4));
         let t_hash = seconds_since(None);
         let wide4_hash = match &wide4 {
-            Some(tree) if wants(WideMethod::Bvh4Hash) => Some(match keyed_nodes(tree) {
+            Some(tree) if needs(Part::Wide4Hash) => Some(match keyed_nodes(tree) {
                 Ok((entries, keys)) => {
                     let (tables, stats) = PerfectHash::build(&entries, tree.nodes().len())?;
                     Ok(KeyedHash { hash: BuiltHash { tables, stats }, keys })
@@ -206,7 +196,7 @@ impl PreparedScene {
         };
         timings.wide_hash = seconds_since(Some(t_hash));
         let t5 = seconds_since(None);
-        let levels = if methods.contains(&Method::Stream(StreamMethod::Frustum8)) {
+        let levels = if needs(Part::Levels) {
             let bounds = bvh.nodes()[0].bounds;
             Some(match &wide8 {
                 Some(w) => LevelBvh::new(w, &bounds)?,

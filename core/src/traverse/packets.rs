@@ -4,9 +4,9 @@
 //! same rays everywhere and per-ray counters and enumerations agree (a packet's nodes depend on
 //! its rays).
 //!
-//! A batch is cut into chunks of [`PACKET_CHUNK`] rays; in each, rays are stably grouped by
+//! A batch is cut into spans of [`GROUPING_RAYS`] rays; in each, rays are stably grouped by
 //! direction octant ([`octant`]) in octant order, and each octant's run is cut into packets of at
-//! most the packet width. Packets never span two chunks, so a backend may trace chunks in
+//! most the packet width. Packets never cross two spans, so a backend may trace spans in
 //! parallel.
 
 #[cfg(feature = "alloc")]
@@ -15,8 +15,9 @@ use crate::Ray;
 #[cfg(feature = "alloc")]
 use alloc::vec::Vec;
 
-/// Rays per chunk of the packet grouping (a CPU backend's natural task size).
-pub const PACKET_CHUNK: usize = 256;
+/// Rays per grouping span: packets are formed within consecutive spans of this many rays of a
+/// batch and never across two, so a backend may trace spans (or multiples of them) in parallel.
+pub const GROUPING_RAYS: usize = 256;
 
 /// A slot of [`packet_slots`] that holds no ray.
 pub const PADDING: u32 = u32::MAX;
@@ -30,13 +31,13 @@ pub fn octant(ray: &Ray) -> usize {
         | (ray.dir[2].is_sign_negative() as usize) << 2
 }
 
-/// Calls `packet` with the rays of each packet of one chunk (at most [`PACKET_CHUNK`] rays; the
+/// Calls `packet` with the rays of each packet of one chunk (at most [`GROUPING_RAYS`] rays; the
 /// rest is ignored), as indices into `chunk`, in packet order: each octant's rays in chunk order,
 /// cut into runs of at most `width` (at least 1). Needs no allocation: a counting sort by octant.
 /// Inlined, so that `packet` compiles as its caller does (for a vector extension, say).
 #[inline(always)]
 pub fn for_each_packet(chunk: &[Ray], width: usize, mut packet: impl FnMut(&[u16])) {
-    let chunk = &chunk[..chunk.len().min(PACKET_CHUNK)];
+    let chunk = &chunk[..chunk.len().min(GROUPING_RAYS)];
     let mut start = [0usize; 9];
     for r in chunk {
         start[octant(r) + 1] += 1;
@@ -44,7 +45,7 @@ pub fn for_each_packet(chunk: &[Ray], width: usize, mut packet: impl FnMut(&[u16
     for o in 0..8 {
         start[o + 1] += start[o];
     }
-    let mut order = [0u16; PACKET_CHUNK];
+    let mut order = [0u16; GROUPING_RAYS];
     let mut at = start;
     for (i, r) in chunk.iter().enumerate() {
         let o = octant(r);
@@ -63,10 +64,10 @@ pub fn for_each_packet(chunk: &[Ray], width: usize, mut packet: impl FnMut(&[u16
 #[cfg(feature = "alloc")]
 pub fn packet_slots_of(rays: &[Ray], width: usize) -> Vec<u32> {
     let width = width.max(1);
-    let mut out = Vec::with_capacity(rays.len() + rays.len().div_ceil(PACKET_CHUNK) * 8 * (width - 1));
-    for (c, chunk) in rays.chunks(PACKET_CHUNK).enumerate() {
+    let mut out = Vec::with_capacity(rays.len() + rays.len().div_ceil(GROUPING_RAYS) * 8 * (width - 1));
+    for (c, chunk) in rays.chunks(GROUPING_RAYS).enumerate() {
         for_each_packet(chunk, width, |p| {
-            out.extend(p.iter().map(|&i| (c * PACKET_CHUNK) as u32 + u32::from(i)));
+            out.extend(p.iter().map(|&i| (c * GROUPING_RAYS) as u32 + u32::from(i)));
             out.extend(core::iter::repeat_n(PADDING, width - p.len()));
         });
     }
@@ -96,7 +97,7 @@ mod tests {
     /// Rays over every octant, with signed zeros, in a scrambled order, over three chunks.
     fn mixed() -> Vec<Ray> {
         let s = [1.0, -1.0, 0.0, -0.0, 0.5, -2.0];
-        (0..(2 * PACKET_CHUNK + 67) as u32)
+        (0..(2 * GROUPING_RAYS + 67) as u32)
             .map(|i| {
                 let k = (i as usize * 7) % 216;
                 ray([s[k % 6], s[(k / 6) % 6], s[k / 36]])
@@ -108,12 +109,12 @@ mod tests {
     /// most four rays of one octant.
     fn by_sorting(rays: &[Ray]) -> Vec<Vec<u32>> {
         let mut packets = Vec::new();
-        for (c, chunk) in rays.chunks(PACKET_CHUNK).enumerate() {
+        for (c, chunk) in rays.chunks(GROUPING_RAYS).enumerate() {
             let mut order: Vec<u32> = (0..chunk.len() as u32).collect();
             order.sort_by_key(|&i| octant(&chunk[i as usize]));
             for run in order.chunk_by(|&a, &b| octant(&chunk[a as usize]) == octant(&chunk[b as usize])) {
                 for p in run.chunks(PACKET_WIDTH) {
-                    packets.push(p.iter().map(|&i| (c * PACKET_CHUNK) as u32 + i).collect());
+                    packets.push(p.iter().map(|&i| (c * GROUPING_RAYS) as u32 + i).collect());
                 }
             }
         }
@@ -150,12 +151,12 @@ mod tests {
             let slots = packet_slots_of(&rays, width);
             assert_eq!(slots.len() % width, 0);
             let mut want = Vec::new();
-            for (c, chunk) in rays.chunks(PACKET_CHUNK).enumerate() {
+            for (c, chunk) in rays.chunks(GROUPING_RAYS).enumerate() {
                 let mut order: Vec<u32> = (0..chunk.len() as u32).collect();
                 order.sort_by_key(|&i| octant(&chunk[i as usize]));
                 for run in order.chunk_by(|&a, &b| octant(&chunk[a as usize]) == octant(&chunk[b as usize])) {
                     for p in run.chunks(width) {
-                        want.extend(p.iter().map(|&i| (c * PACKET_CHUNK) as u32 + i));
+                        want.extend(p.iter().map(|&i| (c * GROUPING_RAYS) as u32 + i));
                         want.extend(core::iter::repeat_n(PADDING, width - p.len()));
                     }
                 }
@@ -167,7 +168,7 @@ mod tests {
     #[test]
     fn packets_never_span_two_chunks() {
         for p in packets(&mixed()) {
-            assert!(p.iter().all(|&i| i as usize / PACKET_CHUNK == p[0] as usize / PACKET_CHUNK), "{p:?}");
+            assert!(p.iter().all(|&i| i as usize / GROUPING_RAYS == p[0] as usize / GROUPING_RAYS), "{p:?}");
         }
     }
 

@@ -47,3 +47,8 @@ pub use tree::{WideBvh, WideStats, WideTree};
 /// measured best; at 16,384 the rays' records and lists outgrow a 1 MB L2 and the stream lost
 /// (`docs/notes/*-benchmarks-bvh8-stream.md`, "A ray-stream prototype").
 pub const STREAM_RAYS: usize = 4096;
+
+/// Rays per wide packet of [`packet`]: four registers of eight lanes on AVX2, and where packets measured best
+/// against single rays on coherent rays (the prototype's 8 to 64 rays:
+/// `docs/notes/*-benchmarks-ci-and-single-ray.md`, "Single-ray changes that did not pay").
+pub const WIDE_PACKET: usize = 32;

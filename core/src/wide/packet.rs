@@ -37,15 +37,12 @@ use super::traverse::{leaf, visiting_order, WideRayContext, WideRoot, WideState,
 use crate::intersect::{RayContext, SlabRay, TriangleTest};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::packets::{for_each_packet, PACKET_CHUNK};
-use crate::traverse::{begin_slab, QueryState};
+use crate::traverse::packets::{for_each_packet, GROUPING_RAYS};
+use crate::traverse::{begin_slab, Machine, QueryState};
 use crate::{Hit, Ray};
 use core::mem::MaybeUninit;
 
-/// Rays per wide packet: four registers of eight lanes on AVX2, and where packets measured best
-/// against single rays on coherent rays (the prototype's 8 to 64 rays:
-/// `docs/notes/*-benchmarks-ci-and-single-ray.md`, "Single-ray changes that did not pay").
-pub const WIDE_PACKET: usize = 32;
+pub use super::WIDE_PACKET;
 
 /// Rays at or below which a packet hands a child over to its rays (see the module docs). A box
 /// test of a node for a packet costs about as much for one ray as for eight (a register of rays
@@ -342,7 +339,7 @@ pub fn trace_wide_packet<
     let mut current = (active != 0).then_some((root.root, active));
     let mut budget = root.max_steps;
     // The single-ray state of the rays handed over (its stack storage is left uninitialized).
-    let mut single = WideState::<W>::new(root.root);
+    let mut single = WideState::<W, K>::new(root.root);
     while let Some((child, mask)) = current {
         let hand_over = mask.count_ones() <= HAND_OVER;
         if O::ENABLED && !hand_over {
@@ -350,8 +347,10 @@ pub fn trace_wide_packet<
         }
         let next = match child {
             _ if hand_over => {
-                let sub = WideRoot { root: child, ..root };
-                each_alone::<T, O, N>(mask, &mut lanes, obs, |c, q, o| single.run::<M, T, K, O>(mem, sub, c, q, o));
+                each_alone::<T, O, N>(mask, &mut lanes, obs, |c, q, o| {
+                    single.restart(child);
+                    single.run(mem, c, q, o, root.max_steps)
+                });
                 settle(mask, &mut lanes, &mut active);
                 pop::<N, P, O>(&stack, &mut len, &lanes.rays, active, obs)
             }
@@ -466,7 +465,7 @@ fn pop<const N: usize, P: PacketKernel, O: Observer>(
 }
 
 /// Traces `rays` into `hits` in the packets of the grouping ([`for_each_packet`] with
-/// [`WIDE_PACKET`] rays, over chunks of [`PACKET_CHUNK`] from the start of `rays`), handing each
+/// [`WIDE_PACKET`] rays, over chunks of [`GROUPING_RAYS`] from the start of `rays`), handing each
 /// ray's index and observer to `done` once its packet is traced.
 #[inline(always)]
 pub fn trace_wide_packets<
@@ -485,8 +484,8 @@ pub fn trace_wide_packets<
     mut done: impl FnMut(usize, O),
 ) {
     let n = rays.len().min(hits.len());
-    for (c, chunk) in rays[..n].chunks(PACKET_CHUNK).enumerate() {
-        let base = c * PACKET_CHUNK;
+    for (c, chunk) in rays[..n].chunks(GROUPING_RAYS).enumerate() {
+        let base = c * GROUPING_RAYS;
         // This closure holds a packet's whole traversal. The compiler inlines it into the
         // caller's AVX2 loop only while it stays small: out of line it is not compiled for AVX2,
         // and every kernel call in it stays a call (the instantiations that record enumerations

@@ -39,25 +39,55 @@ use crate::intersect::TriangleTest;
 use crate::key::Key;
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer, RegisterSource};
-use crate::traverse::{for_each_ray, QueryState};
+use crate::traverse::{for_each_ray, Machine, QueryState, Step};
 use crate::{Hit, Ray};
+use core::marker::PhantomData;
 
-/// Traces one ray from `root` to its end, keyed by `K` (wide enough for the tree's depth:
-/// [`super::keyed::wide_key_width`]).
-#[inline(always)]
-pub fn run<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTest, C: ChildKernel, O: Observer>(
-    mem: &M,
-    root: WideRoot,
-    ctx: &WideRayContext<T>,
-    q: &mut QueryState,
-    obs: &mut O,
-) {
-    let (mut current, mut key, mut trail, mut budget) = (root.root, K::ONE, K::ZERO, root.max_steps);
-    // The parent of the level of the trail's lowest set bit, where known.
-    let mut register = None;
-    loop {
+/// One ray's stackless state: the child being visited, its key and trail, and the register (the
+/// parent of the level of the trail's lowest set bit, where known). `K` is wide enough for the
+/// tree's depth ([`super::keyed::wide_key_width`]); `C` tests and orders each node's children.
+#[derive(Clone, Copy, Debug)]
+pub struct WideTrailState<const W: usize, K: Key, C: ChildKernel> {
+    current: Option<WideChild>,
+    key: K,
+    trail: K,
+    register: Option<u32>,
+    kernel: PhantomData<C>,
+}
+
+impl<const W: usize, K: Key, C: ChildKernel> WideTrailState<W, K, C> {
+    /// Starts at `root` (key 1, empty trail, empty register).
+    #[inline(always)]
+    pub fn new(root: WideChild) -> Self {
+        Self { current: Some(root), key: K::ONE, trail: K::ZERO, register: None, kernel: PhantomData }
+    }
+}
+
+/// Where a visit leaves the walk.
+enum Visit<K> {
+    /// Go to this child, with its key and trail.
+    Next(WideChild, K, K),
+    /// The ray is done.
+    Done,
+}
+
+impl<const W: usize, K: Key, C: ChildKernel> WideTrailState<W, K, C> {
+    /// Visits `current` and finds the child after it: descends to the first child in the visiting
+    /// order, or backtracks through the register or the hash. The one transition of both
+    /// [`Machine::step`] and [`Machine::run`].
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn visit<M: WideKeyedMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
+        current: WideChild,
+        key: K,
+        trail: K,
+        register: &mut Option<u32>,
+        mem: &M,
+        ctx: &WideRayContext<T>,
+        q: &mut QueryState,
+        obs: &mut O,
+    ) -> Visit<K> {
         obs.node(current.node_ref());
-        let mut descended = false;
         match current {
             WideChild::Node(index) => {
                 let node = mem.wide_node(index);
@@ -66,33 +96,70 @@ pub fn run<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTe
                 if hits.mask != 0 {
                     let mut order = [0u32; W];
                     let n = visiting_order::<W, C>(&hits, q.any, &mut order);
-                    let Some(first) = node.child_ref(order[0] as usize) else { return };
-                    current = first;
-                    key = child_key::<W, K>(key, order[0]);
-                    trail = trail.shl(1) | if n > 1 { K::ONE } else { K::ZERO };
+                    let Some(first) = node.child_ref(order[0] as usize) else { return Visit::Done };
                     if n > 1 {
-                        register = Some(index);
+                        *register = Some(index);
                     }
-                    descended = true;
+                    let trail = trail.shl(1) | if n > 1 { K::ONE } else { K::ZERO };
+                    return Visit::Next(first, child_key::<W, K>(key, order[0]), trail);
                 }
             }
             WideChild::Leaf { first, count } => {
                 leaf::<W, M, T, C, O>(mem, first, count, ctx, q, obs);
                 if q.is_answered() {
+                    return Visit::Done;
+                }
+            }
+        }
+        match backtrack::<W, K, M, T, C, O>(mem, key, trail, register, ctx, q, obs) {
+            Some((next, k, t)) => Visit::Next(next, k, t),
+            None => Visit::Done,
+        }
+    }
+}
+
+impl<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTest, C: ChildKernel>
+    Machine<M, WideRayContext<T>> for WideTrailState<W, K, C>
+{
+    /// Visits one node or leaf; see [`Step`]. (The walk does not pause, so it reports no
+    /// [`Step::AfterHit`].)
+    #[inline(always)]
+    fn step<O: Observer>(&mut self, mem: &M, ctx: &WideRayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
+        let Some(current) = self.current else { return Step::Done };
+        match Self::visit(current, self.key, self.trail, &mut self.register, mem, ctx, q, obs) {
+            Visit::Next(next, key, trail) => {
+                (self.current, self.key, self.trail) = (Some(next), key, trail);
+                Step::Continue
+            }
+            Visit::Done => {
+                self.current = None;
+                Step::Done
+            }
+        }
+    }
+
+    /// [`Machine::run`] as one loop with the walk's registers in locals, as the stack walk's
+    /// ([`WideState`](super::traverse::WideState)): `step`'s transitions in its order.
+    #[inline(always)]
+    fn run<O: Observer>(&mut self, mem: &M, ctx: &WideRayContext<T>, q: &mut QueryState, obs: &mut O, max_steps: u32) {
+        let Some(mut current) = self.current else { return };
+        let (mut key, mut trail, mut register, mut budget) = (self.key, self.trail, self.register, max_steps);
+        loop {
+            match Self::visit(current, key, trail, &mut register, mem, ctx, q, obs) {
+                Visit::Next(next, k, t) if budget > 0 => {
+                    (current, key, trail) = (next, k, t);
+                    budget -= 1;
+                }
+                Visit::Next(next, k, t) => {
+                    *self = Self { current: Some(next), key: k, trail: t, register, kernel: PhantomData };
+                    return;
+                }
+                Visit::Done => {
+                    *self = Self { current: None, key, trail, register, kernel: PhantomData };
                     return;
                 }
             }
         }
-        if !descended {
-            let Some((next, k, t)) = backtrack::<W, K, M, T, C, O>(mem, key, trail, &mut register, ctx, q, obs) else {
-                return;
-            };
-            (current, key, trail) = (next, k, t);
-        }
-        if budget == 0 {
-            return;
-        }
-        budget -= 1;
     }
 }
 
@@ -189,7 +256,7 @@ pub fn trace_wide_trail_batch<
     obs: &mut O,
 ) {
     for_each_ray::<T, crate::intersect::NoPair>(rays, hits, root.scene_scale, query, |ctx, q| {
-        run::<W, K, M, T, C, O>(mem, root, ctx, q, obs);
+        WideTrailState::<W, K, C>::new(root.root).run(mem, ctx, q, obs, root.max_steps);
     });
 }
 

@@ -8,8 +8,9 @@ use super::node::WideChild;
 use crate::intersect::{BlockHits, NoPair, RayContext, TriangleHit, TriangleTest, BLOCK};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::{for_each_ray, QueryState, Step};
+use crate::traverse::{for_each_ray, Machine, QueryState, Step};
 use crate::{Hit, Ray};
+use core::marker::PhantomData;
 use core::mem::MaybeUninit;
 
 /// Stack entries: enough for `W - 1` postponed children on each of 63 levels, `W` up to 8.
@@ -31,22 +32,23 @@ pub struct WideRoot {
 }
 
 /// One ray's traversal state: the child being visited, and the postponed children with the entry
-/// distances they were found at.
+/// distances they were found at. `K` tests and orders each node's children.
 ///
 /// The stack's storage is left uninitialized: only the entries below `len` are ever read, and each
-/// was written by a push first. Filling all 448 entries on every `new` (5 KiB) tripled the cost of
-/// a ray traced on its own on a Cortex-M4F (21.6k instructions against 7.7k in a batch).
+/// was written by a push first, so a ray traced on its own does not pay for writing all
+/// [`WIDE_STACK`] entries (5 KiB) up front.
 #[derive(Clone, Debug)]
-pub struct WideState<const W: usize> {
+pub struct WideState<const W: usize, K: ChildKernel> {
     current: Option<WideChild>,
     len: usize,
     stack: [MaybeUninit<Postponed>; WIDE_STACK],
+    kernel: PhantomData<K>,
 }
 
-impl<const W: usize> WideState<W> {
+impl<const W: usize, K: ChildKernel> WideState<W, K> {
     /// Starts at `root`.
     pub fn new(root: WideChild) -> Self {
-        Self { current: Some(root), len: 0, stack: [const { MaybeUninit::uninit() }; WIDE_STACK] }
+        Self { current: Some(root), len: 0, stack: [const { MaybeUninit::uninit() }; WIDE_STACK], kernel: PhantomData }
     }
 
     /// Starts over at `root` for another ray, keeping the stack's storage.
@@ -55,16 +57,14 @@ impl<const W: usize> WideState<W> {
         self.current = Some(root);
         self.len = 0;
     }
+}
 
+impl<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel> Machine<M, WideRayContext<T>>
+    for WideState<W, K>
+{
     /// Processes one node or leaf; see [`Step`].
     #[inline(always)]
-    pub fn step<M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &WideRayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
+    fn step<O: Observer>(&mut self, mem: &M, ctx: &WideRayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
         let Some(current) = self.current else { return Step::Done };
         obs.node(current.node_ref());
         let after_hit = match current {
@@ -95,34 +95,50 @@ impl<const W: usize> WideState<W> {
         }
     }
 
-    /// Traces one ray from `root` to its end: [`WideState::step`] until it is done, or until
-    /// `root.max_steps` more steps have been taken, as one loop. The node being visited and the
-    /// stack height live in locals rather than in `self` between steps, so they stay in
-    /// registers: 5-15% faster than calling `step`
-    /// (`docs/notes/*-benchmarks-one-loop.md`, "One loop per ray"). The transitions are `step`'s,
-    /// in its order, so the answer and the events are the same.
+    /// [`Machine::run`] as one loop, with the node being visited and the stack height in locals
+    /// rather than in `self` between steps, so that they stay in registers: 5-15% faster than
+    /// stepping (`docs/notes/*-benchmarks-one-loop.md`, "One loop per ray"). The transitions are
+    /// `step`'s, in its order, so the answer and the events are the same.
     #[inline(always)]
-    pub fn run<M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel, O: Observer>(
+    fn run<O: Observer>(&mut self, mem: &M, ctx: &WideRayContext<T>, q: &mut QueryState, obs: &mut O, max_steps: u32) {
+        if let Some(current) = self.current {
+            self.run_from(current, self.len, mem, ctx, q, obs, max_steps);
+        }
+    }
+}
+
+impl<const W: usize, K: ChildKernel> WideState<W, K> {
+    /// [`Machine::run`] from `current` with `len` entries on the stack: the batch loop starts each
+    /// ray here, its start in registers rather than stored in the state and read back.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn run_from<M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
         &mut self,
+        mut current: WideChild,
+        mut len: usize,
         mem: &M,
-        root: WideRoot,
         ctx: &WideRayContext<T>,
         q: &mut QueryState,
         obs: &mut O,
+        max_steps: u32,
     ) {
-        let (mut current, mut len, mut budget) = (root.root, 0usize, root.max_steps);
+        let mut budget = max_steps;
         loop {
             obs.node(current.node_ref());
             let next = match current {
                 WideChild::Node(index) => match expand::<W, M, T, K>(&mut self.stack, &mut len, mem, index, ctx, q) {
                     Expanded::Next(c) => Some(c),
                     // `step` leaves no node to visit: its next call ends the ray.
-                    Expanded::EmptyFirst => return,
+                    Expanded::EmptyFirst => {
+                        self.current = None;
+                        return;
+                    }
                     Expanded::NoneHit => pop(&self.stack, &mut len, ctx, q, obs),
                 },
                 WideChild::Leaf { first, count } => {
                     leaf::<W, M, T, K, O>(mem, first, count, ctx, q, obs);
                     if q.is_answered() {
+                        self.current = None;
                         return;
                     }
                     pop(&self.stack, &mut len, ctx, q, obs)
@@ -133,7 +149,10 @@ impl<const W: usize> WideState<W> {
                     budget -= 1;
                     current = c;
                 }
-                _ => return,
+                _ => {
+                    (self.current, self.len) = (next, len);
+                    return;
+                }
             }
         }
     }
@@ -344,9 +363,9 @@ pub fn trace_wide_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTe
     query: Query,
     obs: &mut O,
 ) {
-    let mut state = WideState::<W>::new(root.root);
+    let mut state = WideState::<W, K>::new(root.root);
     for_each_ray::<T, NoPair>(rays, hits, root.scene_scale, query, |ctx, q| {
-        state.run::<M, T, K, O>(mem, root, ctx, q, obs);
+        state.run_from(root.root, 0, mem, ctx, q, obs, root.max_steps);
     });
 }
 

@@ -1,18 +1,19 @@
 //! BVH2 lanes: the core's BVH2 state machines ([`Machine`]) over a [`CountingMemory`].
 
-use crate::machine::{Machine, Resuming};
 use crate::memory::{CountingMemory, Traffic};
 use crate::sim::{drive, LaneObserver, MethodRun, SimConfig};
+use crate::start::Start;
 use crate::stepper::{Outcome, Stepper};
 use raytrail_core::bvh2::traverse::{
-    order_children, Descent, ParentSiblingState, PerfectHashLookup, RegisterState, StackState, TraceRoot, UncleHops,
+    order_children, Descent, ParentSiblingState, PausingState, PerfectHashLookup, RegisterState, StackState, TraceRoot,
+    UncleHops,
 };
 use raytrail_core::bvh2::BvhMemory;
 use raytrail_core::intersect::{RayContext, Watertight};
 use raytrail_core::key::{Key, KeyWidth};
 use raytrail_core::method::Bvh2Method;
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::traverse::QueryState;
+use raytrail_core::traverse::{Machine, QueryState, Step};
 use raytrail_core::{Error, Ray};
 use std::marker::PhantomData;
 
@@ -32,21 +33,18 @@ pub(crate) fn simulate_bvh2(
 fn keyed<K: Key>(prepared: &PreparedScene, m: Bvh2Method, rays: &[Ray], cfg: &SimConfig) -> Result<MethodRun, Error> {
     let mem = CountingMemory::new(prepared.memory(m)?);
     let root = prepared.root(m)?;
-    let stack = matches!(m, Bvh2Method::Stack | Bvh2Method::StackDisjoint);
     Ok(match m {
-        Bvh2Method::Stack => drive(&Bvh2Lanes::<_, StackState<false>>::new(&mem, root, stack), rays, cfg),
-        Bvh2Method::StackDisjoint => drive(&Bvh2Lanes::<_, StackState<true>>::new(&mem, root, stack), rays, cfg),
-        Bvh2Method::ParentSibling => drive(&Bvh2Lanes::<_, ParentSiblingState<K>>::new(&mem, root, stack), rays, cfg),
-        Bvh2Method::Uncle => {
-            drive(&Bvh2Lanes::<_, RegisterState<K, UncleHops, false>>::new(&mem, root, stack), rays, cfg)
-        }
+        Bvh2Method::Stack => drive(&Bvh2Lanes::<_, StackState<false>>::new(&mem, root, m), rays, cfg),
+        Bvh2Method::StackDisjoint => drive(&Bvh2Lanes::<_, StackState<true>>::new(&mem, root, m), rays, cfg),
+        Bvh2Method::ParentSibling => drive(&Bvh2Lanes::<_, ParentSiblingState<K>>::new(&mem, root, m), rays, cfg),
+        Bvh2Method::Uncle => drive(&Bvh2Lanes::<_, RegisterState<K, UncleHops, false>>::new(&mem, root, m), rays, cfg),
         Bvh2Method::Hash => {
-            drive(&Bvh2Lanes::<_, RegisterState<K, PerfectHashLookup, false>>::new(&mem, root, stack), rays, cfg)
+            drive(&Bvh2Lanes::<_, RegisterState<K, PerfectHashLookup, false>>::new(&mem, root, m), rays, cfg)
         }
         Bvh2Method::HashDisjoint => {
-            drive(&Bvh2Lanes::<_, RegisterState<K, PerfectHashLookup, true>>::new(&mem, root, stack), rays, cfg)
+            drive(&Bvh2Lanes::<_, RegisterState<K, PerfectHashLookup, true>>::new(&mem, root, m), rays, cfg)
         }
-        Bvh2Method::HashResume => drive(&Bvh2Lanes::<_, Resuming<K>>::new(&mem, root, stack), rays, cfg),
+        Bvh2Method::HashResume => drive(&Bvh2Lanes::<_, PausingState<K>>::new(&mem, root, m), rays, cfg),
     })
 }
 
@@ -56,16 +54,20 @@ struct Bvh2Lanes<'a, M: BvhMemory, S> {
     root: TraceRoot,
     /// Whether the method keeps a stack (else a postponed node goes to the register).
     stack: bool,
+    /// Whether the method pauses after each accepted hit and resumes through the hash (f).
+    resumes: bool,
     machine: PhantomData<S>,
 }
 
-impl<'a, M: BvhMemory, S: Machine> Bvh2Lanes<'a, M, S> {
-    fn new(mem: &'a CountingMemory<M>, root: TraceRoot, stack: bool) -> Self {
-        Self { mem, root, stack, machine: PhantomData }
+impl<'a, M: BvhMemory, S> Bvh2Lanes<'a, M, S> {
+    fn new(mem: &'a CountingMemory<M>, root: TraceRoot, method: Bvh2Method) -> Self {
+        let stack = matches!(method, Bvh2Method::Stack | Bvh2Method::StackDisjoint);
+        let resumes = method == Bvh2Method::HashResume;
+        Self { mem, root, stack, resumes, machine: PhantomData }
     }
 }
 
-impl<M: BvhMemory, S: Machine> Stepper for Bvh2Lanes<'_, M, S> {
+impl<M: BvhMemory, S: Start + Machine<CountingMemory<M>, RayContext<Watertight>>> Stepper for Bvh2Lanes<'_, M, S> {
     type Lane = (S, RayContext<Watertight>);
 
     fn begin(&self, ray: &Ray) -> Option<Self::Lane> {
@@ -79,7 +81,9 @@ impl<M: BvhMemory, S: Machine> Stepper for Bvh2Lanes<'_, M, S> {
         // The culling distance before the step: an internal node's step uses it unchanged.
         let limit = q.limit();
         let hash_reads = self.mem.hash_reads();
-        let (step, resumed) = state.step(self.mem, ctx, q, obs);
+        let step = state.step(self.mem, ctx, q, obs);
+        // Only method (f) pauses and resumes, within each step that accepts a hit.
+        let resumed = self.resumes && step == Step::AfterHit;
         let ev = obs.step;
         // Lanes step one after another, so the counter's growth is this lane's.
         let rounds = 1 + ev.link_reads + (self.mem.hash_reads() - hash_reads) as u32;

@@ -19,7 +19,7 @@ use raytrail_core::kd::{KdMemory, KdSliceMemory};
 use raytrail_core::method::KdMethod;
 use raytrail_core::observe::Backtrack;
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::traverse::{begin_slab, QueryState, Step};
+use raytrail_core::traverse::{begin_slab, Machine, QueryState, Step};
 use raytrail_core::{Error, Ray};
 use std::cell::Cell;
 

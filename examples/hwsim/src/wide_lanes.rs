@@ -7,7 +7,7 @@ use crate::stepper::{Outcome, Stepper};
 use raytrail_core::intersect::{NoPair, Watertight};
 use raytrail_core::method::{Query, WideMethod};
 use raytrail_core::prepared::PreparedScene;
-use raytrail_core::traverse::{begin, QueryState};
+use raytrail_core::traverse::{begin, Machine, QueryState};
 use raytrail_core::wide::traverse::{WideRayContext, WideRoot, WideState};
 use raytrail_core::wide::{ChildKernel, FastKernel, WideMemory, WideTree};
 use raytrail_core::{Error, Ray};
@@ -43,7 +43,7 @@ impl<const W: usize, M: WideMemory<W>> WideLanes<W, M> {
 }
 
 impl<const W: usize, M: WideMemory<W>> Stepper for WideLanes<W, M> {
-    type Lane = (WideState<W>, WideRayContext<Watertight>);
+    type Lane = (WideState<W, FastKernel>, WideRayContext<Watertight>);
 
     fn begin(&self, ray: &Ray) -> Option<Self::Lane> {
         // As `trace_wide_batch`: a ray `begin` turns away visits nothing.
@@ -53,7 +53,7 @@ impl<const W: usize, M: WideMemory<W>> Stepper for WideLanes<W, M> {
 
     fn step(&self, (state, ctx): &mut Self::Lane, q: &mut QueryState, obs: &mut LaneObserver) -> Outcome {
         let limit = q.limit();
-        let step = state.step::<_, Watertight, FastKernel, _>(&self.mem, ctx, q, obs);
+        let step = state.step(&self.mem, ctx, q, obs);
         // Re-derive (without counting the read) how many children the node postponed: every hit
         // child but the one visited next is pushed.
         let pushed = obs.step.node.filter(|n| !n.is_leaf()).map_or(0, |n| {

@@ -4,14 +4,12 @@
 //! opaque zero, `div_rn`, the slab test) and `stream_common.wgsl`; the intersection kernel adds the
 //! triangle test, query, recording and wide.wgsl's leaf test, as the wide methods' kernels do.
 
-use crate::compose::Variant;
+use super::shared_parts::{stream_header, Part, INTERSECT_OWN, STREAM_COMMON, STREAM_LEVELS};
+use crate::compose::{constants_header, Variant};
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Method, StreamMethod};
-use raytrail_core::stream::frustum::{MARGIN, NO_AXIS};
 use raytrail_core::trace::{Record, TraceOptions};
 use raytrail_core::Error;
-
-type Part = (&'static str, &'static str);
 
 macro_rules! part {
     ($source:ident) => {
@@ -97,7 +95,7 @@ impl StreamKernel {
 
     /// The kernel's own files, after the common ones.
     fn own_parts(&self) -> Vec<Part> {
-        let levels = part!(STREAM_LEVELS);
+        let levels = STREAM_LEVELS;
         match self {
             StreamKernel::Keys => vec![part!(STREAM_KEYS)],
             StreamKernel::Heads => vec![part!(STREAM_HEADS)],
@@ -119,33 +117,28 @@ impl StreamKernel {
             StreamKernel::Expand => vec![levels, part!(STREAM_CULL), part!(STREAM_EXPAND)],
             StreamKernel::PairScatter => vec![part!(STREAM_PAIR_SCATTER)],
             StreamKernel::Ranges => vec![part!(STREAM_RANGES)],
-            StreamKernel::Intersect(_) => vec![levels, part!(STREAM_INTERSECT)],
+            StreamKernel::Intersect(_) => INTERSECT_OWN.to_vec(),
         }
     }
 
-    /// The files of the kernel, in order.
+    /// The files of the kernel, in order (the intersection kernel's as its [`Variant`] composes
+    /// them).
     pub(crate) fn parts(&self) -> Result<Vec<Part>, Error> {
-        let mut parts = match self {
-            // The wide methods' files without work items or dispatch (the stream file has its own).
-            StreamKernel::Intersect(v) => {
-                Variant { method: Method::Wide(raytrail_core::method::WideMethod::Bvh8), ..*v }.method_parts()?
-            }
-            _ => vec![part!(PRELUDE), part!(NUMERICS), part!(BOX)],
-        };
-        parts.push(part!(STREAM_COMMON));
+        if let StreamKernel::Intersect(v) = self {
+            return v.parts();
+        }
+        let mut parts = vec![part!(PRELUDE), part!(NUMERICS), part!(BOX), STREAM_COMMON];
         parts.extend(self.own_parts());
         Ok(parts)
     }
 
     /// The full source: the generated constants, then the files.
     pub(crate) fn source(&self) -> Result<String, Error> {
-        let mut s = crate::compose::constants_header(Method::Stream(StreamMethod::Frustum8));
-        s.push_str(&format!(
-            "// The stream method's constants, from raytrail-core.\n\
-             const STREAM_MARGIN_BITS: u32 = {:#010x}u;\n\
-             const NO_AXIS: u32 = {NO_AXIS}u;\n",
-            MARGIN.to_bits()
-        ));
+        if let StreamKernel::Intersect(v) = self {
+            return v.source();
+        }
+        let mut s = constants_header(Method::Stream(StreamMethod::Frustum8));
+        s.push_str(&stream_header());
         for (name, text) in self.parts()? {
             s.push_str(&format!("\n// ---- shaders/{name} ----\n"));
             s.push_str(text);

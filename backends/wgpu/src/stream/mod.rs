@@ -9,6 +9,7 @@ pub(crate) mod kernels;
 mod plan;
 mod run;
 mod scan;
+pub(crate) mod shared_parts;
 mod sort;
 mod trace;
 mod traverse;

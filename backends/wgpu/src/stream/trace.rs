@@ -162,7 +162,7 @@ fn trace_checked(
     };
     let mut report = Report::new(rays.len(), 0.0);
     report.kernel_seconds = timed.then(|| seconds.iter().sum());
-    report.transfer_bytes = crate::backend::bytes_moved(rays.len(), stride);
+    report.transfer_bytes = crate::workspace::bytes_moved(rays.len(), stride);
     if options.record != Record::Nothing {
         let mut counters = Counters { rays: rays.len() as u64, ..Counters::default() };
         for slot in back[1].chunks(stride) {

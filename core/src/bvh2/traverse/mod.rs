@@ -6,9 +6,11 @@
 //!   and iterative two-level hops (c);
 //! - [`RegisterState`] with [`PerfectHashLookup`]: constant-time backtracking, Binder & Keller
 //!   2016, Algorithm 1 (d), optionally with the disjoint t-interval mask (e);
-//! - [`Paused`]: pausing after a hit and resuming from a node key (f).
+//! - [`PausingState`]: method (d) pausing after a hit and resuming from a node key ([`Paused`])
+//!   (f).
 //!
-//! Each reads memory only through [`BvhMemory`](super::BvhMemory). The same code is the CPU
+//! Each is a [`Machine`](crate::traverse::Machine) and reads memory only through
+//! [`BvhMemory`](super::BvhMemory). The same code is the CPU
 //! backend's hot loop, the hardware simulator's lockstep unit and the reference each shader
 //! mirrors. [`trace_batch`] and [`trace_ray`] take a [`Bvh2Method`](crate::method::Bvh2Method), so
 //! a method of another structure cannot reach them:
@@ -36,6 +38,6 @@ pub use children::{order_children, Descent};
 pub use leaf::intersect_leaf;
 pub use parent_sibling::ParentSiblingState;
 pub use register::{Fallback, PerfectHashLookup, RegisterState, UncleHops};
-pub use resume::{trace_pausing, Paused};
+pub use resume::{Paused, PausingState};
 pub use run::{trace_batch, trace_ray, TraceRoot};
 pub use stack::StackState;

@@ -3,7 +3,7 @@ use crate::bvh2::{BvhMemory, NodeRef};
 use crate::intersect::{RayContext, TriangleTest};
 use crate::key::Key;
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::{QueryState, Step};
+use crate::traverse::{Machine, QueryState, Step};
 
 /// Method (b): stackless traversal with parent and sibling links and a bit trail (Áfra, Szirmay-
 /// Kalos and Keller 2014). Backtracking climbs parent links until the trail shows a postponed
@@ -21,16 +21,12 @@ impl<K: Key> ParentSiblingState<K> {
     pub fn new(root: NodeRef) -> Self {
         Self { addr: root, trail: K::ZERO }
     }
+}
 
+impl<M: BvhMemory + ?Sized, T: TriangleTest, K: Key> Machine<M, RayContext<T>> for ParentSiblingState<K> {
     /// Processes one node; see [`Step`].
     #[inline(always)]
-    pub fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &RayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
+    fn step<O: Observer>(&mut self, mem: &M, ctx: &RayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
         // Only damaged tables lead to an absent node; end rather than read out of bounds.
         if self.addr.is_none() {
             return Step::Done;
@@ -60,7 +56,9 @@ impl<K: Key> ParentSiblingState<K> {
         };
         self.backtrack(mem, links, obs)
     }
+}
 
+impl<K: Key> ParentSiblingState<K> {
     /// Climbs from the current node, whose `[parent, sibling]` links are given.
     #[inline(always)]
     fn backtrack<M: BvhMemory + ?Sized, O: Observer>(&mut self, mem: &M, mut links: [NodeRef; 2], obs: &mut O) -> Step {

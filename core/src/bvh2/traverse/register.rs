@@ -4,7 +4,7 @@ use crate::hash::lookup;
 use crate::intersect::{RayContext, TriangleTest};
 use crate::key::{self, Key};
 use crate::observe::{Backtrack, Observer, RegisterSource};
-use crate::traverse::{QueryState, Step};
+use crate::traverse::{Machine, QueryState, Step};
 
 /// How a [`RegisterState`] finds the next node when the register is empty.
 pub trait Fallback {
@@ -127,16 +127,14 @@ impl<K: Key, F: Fallback, const DISJOINT: bool> RegisterState<K, F, DISJOINT> {
     pub fn key_and_trail(&self) -> (K, K) {
         (self.key, self.trail)
     }
+}
 
+impl<M: BvhMemory + ?Sized, T: TriangleTest, K: Key, F: Fallback, const DISJOINT: bool> Machine<M, RayContext<T>>
+    for RegisterState<K, F, DISJOINT>
+{
     /// Processes one node; see [`Step`].
     #[inline(always)]
-    pub fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &RayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
+    fn step<O: Observer>(&mut self, mem: &M, ctx: &RayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
         // Only damaged tables lead to an absent node; end rather than read out of bounds.
         if self.addr.is_none() {
             return Step::Done;
@@ -183,7 +181,9 @@ impl<K: Key, F: Fallback, const DISJOINT: bool> RegisterState<K, F, DISJOINT> {
         }
         self.backtrack::<M, O>(mem, &links, obs, if hit { Step::AfterHit } else { Step::Continue })
     }
+}
 
+impl<K: Key, F: Fallback, const DISJOINT: bool> RegisterState<K, F, DISJOINT> {
     /// Loads the register from the current node's links when the trail names one of them as the
     /// next target: the lowest set trail bit among 1..=3 (bit 0 is never set with an empty
     /// register, since postponing a sibling fills it).

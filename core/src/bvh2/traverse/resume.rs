@@ -1,11 +1,10 @@
-use super::TraceRoot;
 use super::{PerfectHashLookup, RegisterState};
-use crate::bvh2::BvhMemory;
+use crate::bvh2::{BvhMemory, NodeRef};
 use crate::hash::lookup;
 use crate::intersect::{RayContext, TriangleTest};
 use crate::key::{self, Key};
 use crate::observe::Observer;
-use crate::traverse::{QueryState, Step};
+use crate::traverse::{Machine, QueryState, Step};
 
 /// A paused traversal (Sec. 2.4): the key of the next node and the bit trail. The register need
 /// not be saved, because the backtracking step is made before pausing; the address comes back
@@ -44,22 +43,28 @@ fn ones_below<K: Key>(n: u32) -> K {
 }
 
 /// Method (f): method (d), paused after every leaf that accepts a hit (as a renderer would, to
-/// run an any-hit shader or to reorder rays) and resumed from the saved key and trail alone.
-/// Needs the hash over every node. Visits exactly the nodes method (d) visits.
-#[inline]
-pub fn trace_pausing<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-    mem: &M,
-    root: TraceRoot,
-    ctx: &RayContext<T>,
-    q: &mut QueryState,
-    obs: &mut O,
-) {
-    let mut state = RegisterState::<K, PerfectHashLookup, false>::new(root.node);
-    for _ in 0..=root.max_steps {
-        match state.step(mem, ctx, q, obs) {
-            Step::Continue => {}
-            Step::Done => return,
-            Step::AfterHit => state = Paused::of(&state).resume(mem),
+/// run an any-hit shader or to reorder rays) and resumed from the saved key and trail alone, within
+/// the same step. Needs the hash over every node. Visits exactly the nodes method (d) visits.
+#[derive(Clone, Copy, Debug)]
+pub struct PausingState<K: Key>(RegisterState<K, PerfectHashLookup, false>);
+
+impl<K: Key> PausingState<K> {
+    /// Starts at `root`.
+    #[inline(always)]
+    pub fn new(root: NodeRef) -> Self {
+        Self(RegisterState::new(root))
+    }
+}
+
+impl<M: BvhMemory + ?Sized, T: TriangleTest, K: Key> Machine<M, RayContext<T>> for PausingState<K> {
+    /// One step of method (d); after one that accepted a hit ([`Step::AfterHit`]), the pause and
+    /// the resume through the hash.
+    #[inline(always)]
+    fn step<O: Observer>(&mut self, mem: &M, ctx: &RayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
+        let step = self.0.step(mem, ctx, q, obs);
+        if step == Step::AfterHit {
+            self.0 = Paused::of(&self.0).resume(mem);
         }
+        step
     }
 }

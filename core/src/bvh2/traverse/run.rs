@@ -1,10 +1,10 @@
-use super::{trace_pausing, Fallback, ParentSiblingState, PerfectHashLookup, RegisterState, StackState, UncleHops};
+use super::{ParentSiblingState, PausingState, PerfectHashLookup, RegisterState, StackState, UncleHops};
 use crate::bvh2::{BvhMemory, NodeRef};
-use crate::intersect::{RayContext, SlabPair, TriangleTest};
+use crate::intersect::{SlabPair, TriangleTest};
 use crate::key::Key;
 use crate::method::{Bvh2Method, Query};
 use crate::observe::Observer;
-use crate::traverse::{for_each_ray, QueryState, Step};
+use crate::traverse::{for_each_ray, Machine};
 use crate::{Hit, Ray};
 
 /// Where a traversal starts, with the scene constant every ray needs.
@@ -12,7 +12,7 @@ use crate::{Hit, Ray};
 pub struct TraceRoot {
     /// The root node.
     pub node: NodeRef,
-    /// The largest coordinate magnitude in the scene (for [`RayContext::new`]).
+    /// The largest coordinate magnitude in the scene (for [`RayContext::new`](crate::intersect::RayContext::new)).
     pub scene_scale: f32,
     /// Steps after which traversal stops: the node count, since no method visits a node twice.
     /// It never binds on intact tables; on damaged ones it guarantees termination.
@@ -65,98 +65,30 @@ pub fn trace_batch<K: Key, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
             let mut s = StackState::<false>::new(r);
             for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
                 s.restart(r);
-                drive(&mut s, mem, ctx, q, obs, root.max_steps);
+                s.run(mem, ctx, q, obs, root.max_steps);
             });
         }
         Bvh2Method::StackDisjoint => {
             let mut s = StackState::<true>::new(r);
             for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
                 s.restart(r);
-                drive(&mut s, mem, ctx, q, obs, root.max_steps);
+                s.run(mem, ctx, q, obs, root.max_steps);
             });
         }
         Bvh2Method::ParentSibling => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
-            drive(&mut ParentSiblingState::<K>::new(r), mem, ctx, q, obs, root.max_steps)
+            ParentSiblingState::<K>::new(r).run(mem, ctx, q, obs, root.max_steps)
         }),
         Bvh2Method::Uncle => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
-            drive(&mut RegisterState::<K, UncleHops, false>::new(r), mem, ctx, q, obs, root.max_steps)
+            RegisterState::<K, UncleHops, false>::new(r).run(mem, ctx, q, obs, root.max_steps)
         }),
         Bvh2Method::Hash => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
-            drive(&mut RegisterState::<K, PerfectHashLookup, false>::new(r), mem, ctx, q, obs, root.max_steps)
+            RegisterState::<K, PerfectHashLookup, false>::new(r).run(mem, ctx, q, obs, root.max_steps)
         }),
         Bvh2Method::HashDisjoint => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
-            drive(&mut RegisterState::<K, PerfectHashLookup, true>::new(r), mem, ctx, q, obs, root.max_steps)
+            RegisterState::<K, PerfectHashLookup, true>::new(r).run(mem, ctx, q, obs, root.max_steps)
         }),
         Bvh2Method::HashResume => for_each_ray::<T, SlabPair>(rays, hits, root.scene_scale, query, |ctx, q| {
-            trace_pausing::<K, M, T, O>(mem, root, ctx, q, obs)
+            PausingState::<K>::new(r).run(mem, ctx, q, obs, root.max_steps)
         }),
-    }
-}
-
-/// A BVH2 traversal state that makes one transition per [`Machine::step`].
-trait Machine {
-    /// One transition; see [`Step`].
-    fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &RayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step;
-}
-
-impl<const DISJOINT: bool> Machine for StackState<DISJOINT> {
-    #[inline(always)]
-    fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &RayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
-        StackState::step(self, mem, ctx, q, obs)
-    }
-}
-
-impl<K: Key> Machine for ParentSiblingState<K> {
-    #[inline(always)]
-    fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &RayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
-        ParentSiblingState::step(self, mem, ctx, q, obs)
-    }
-}
-
-impl<K: Key, F: Fallback, const DISJOINT: bool> Machine for RegisterState<K, F, DISJOINT> {
-    #[inline(always)]
-    fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &RayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
-        RegisterState::step(self, mem, ctx, q, obs)
-    }
-}
-
-/// Steps `state` until it is done, or for at most `max_steps` further steps after the first
-/// (see [`TraceRoot::max_steps`]).
-#[inline(always)]
-fn drive<S: Machine, M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-    state: &mut S,
-    mem: &M,
-    ctx: &RayContext<T>,
-    q: &mut QueryState,
-    obs: &mut O,
-    max_steps: u32,
-) {
-    let mut budget = max_steps;
-    while state.step(mem, ctx, q, obs) != Step::Done && budget > 0 {
-        budget -= 1;
     }
 }

@@ -2,7 +2,7 @@ use super::{intersect_leaf, order_children, Descent};
 use crate::bvh2::{BvhMemory, NodeRef};
 use crate::intersect::{RayContext, TriangleTest};
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::{QueryState, Step};
+use crate::traverse::{Machine, QueryState, Step};
 
 /// Deepest stack needed: one entry per level of a tree of depth 63.
 const CAPACITY: usize = 64;
@@ -36,16 +36,12 @@ impl<const DISJOINT: bool> StackState<DISJOINT> {
         self.len = 0;
         self.disjoint = 0;
     }
+}
 
+impl<M: BvhMemory + ?Sized, T: TriangleTest, const DISJOINT: bool> Machine<M, RayContext<T>> for StackState<DISJOINT> {
     /// Processes one node; see [`Step`].
     #[inline(always)]
-    pub fn step<M: BvhMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &RayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
+    fn step<O: Observer>(&mut self, mem: &M, ctx: &RayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
         // Only damaged tables lead to an absent node; end rather than read out of bounds.
         if self.addr.is_none() {
             return Step::Done;
@@ -82,7 +78,9 @@ impl<const DISJOINT: bool> StackState<DISJOINT> {
         }
         self.pop(obs, hit)
     }
+}
 
+impl<const DISJOINT: bool> StackState<DISJOINT> {
     #[inline(always)]
     fn pop<O: Observer>(&mut self, obs: &mut O, after_hit: bool) -> Step {
         if self.len == 0 {

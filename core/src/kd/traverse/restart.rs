@@ -3,7 +3,7 @@ use crate::bvh2::NodeRef;
 use crate::intersect::{KdRayContext, TriangleTest};
 use crate::kd::KdMemory;
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::{QueryState, Step};
+use crate::traverse::{Machine, QueryState, Step};
 
 /// Most entries a short stack may keep.
 pub const SHORT_STACK_MAX: usize = 16;
@@ -71,16 +71,12 @@ impl KdRestartState {
             stack: [(0, 0.0, 0.0); SHORT_STACK_MAX],
         }
     }
+}
 
+impl<M: KdMemory + ?Sized, T: TriangleTest> Machine<M, KdRayContext<T>> for KdRestartState {
     /// Processes one node; see [`Step`].
     #[inline(always)]
-    pub fn step<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &KdRayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
+    fn step<O: Observer>(&mut self, mem: &M, ctx: &KdRayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
         let n = mem.kd_node(self.node);
         if !n.is_leaf() {
             obs.node(NodeRef::internal(self.node));
@@ -120,7 +116,9 @@ impl KdRestartState {
         obs.backtrack(0, Backtrack::Restart);
         Step::Continue
     }
+}
 
+impl KdRestartState {
     #[inline(always)]
     fn push(&mut self, node: u32, t_min: f32, t_max: f32) {
         if self.capacity == 0 {

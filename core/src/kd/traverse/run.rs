@@ -3,7 +3,7 @@ use crate::intersect::{KdRayContext, SlabRay, TriangleTest};
 use crate::kd::KdMemory;
 use crate::method::{KdMethod, Query};
 use crate::observe::Observer;
-use crate::traverse::{begin_slab, QueryState, Step};
+use crate::traverse::{begin_slab, Machine, QueryState};
 use crate::{Hit, Ray};
 use glam::Vec3;
 
@@ -75,23 +75,21 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
     };
     let ctx = KdRayContext::<T>::from_slab(ray, slab);
     let mut q = QueryState::new(ray, query);
-    macro_rules! drive {
-        ($state:expr) => {{
-            let mut s = $state;
-            let mut budget = root.max_steps;
-            while s.step(mem, &ctx, &mut q, obs) != Step::Done && budget > 0 {
-                budget -= 1;
-            }
-        }};
-    }
     match method {
         KdMethod::Stack => KdStackState::new(t0, t1).run(mem, &ctx, &mut q, obs, root.max_steps),
-        KdMethod::Restart => drive!(KdRestartState::new(t0, t1, RestartPolicy::RESTART)),
-        KdMethod::PushDown => drive!(KdRestartState::new(t0, t1, RestartPolicy::PUSH_DOWN)),
-        // The packet method went its own way above.
-        KdMethod::ShortStack | KdMethod::Packet => {
-            drive!(KdRestartState::new(t0, t1, RestartPolicy::short_stack(root.short_stack)))
+        KdMethod::Restart => {
+            KdRestartState::new(t0, t1, RestartPolicy::RESTART).run(mem, &ctx, &mut q, obs, root.max_steps)
         }
+        KdMethod::PushDown => {
+            KdRestartState::new(t0, t1, RestartPolicy::PUSH_DOWN).run(mem, &ctx, &mut q, obs, root.max_steps)
+        }
+        // The packet method went its own way above.
+        KdMethod::ShortStack | KdMethod::Packet => KdRestartState::new(
+            t0,
+            t1,
+            RestartPolicy::short_stack(root.short_stack),
+        )
+        .run(mem, &ctx, &mut q, obs, root.max_steps),
     }
     q.hit
 }

@@ -3,7 +3,7 @@ use crate::bvh2::NodeRef;
 use crate::intersect::{KdRayContext, TriangleTest};
 use crate::kd::KdMemory;
 use crate::observe::{Backtrack, Observer};
-use crate::traverse::{QueryState, Step};
+use crate::traverse::{Machine, QueryState, Step};
 use core::mem::MaybeUninit;
 
 /// Deepest stack a kd-tree of depth 64 can need.
@@ -43,35 +43,23 @@ impl KdStackState {
     pub fn new(t_min: f32, t_max: f32) -> Self {
         Self { node: 0, t_min, t_max, len: 0, stack: [MaybeUninit::uninit(); CAPACITY] }
     }
+}
 
+impl<M: KdMemory + ?Sized, T: TriangleTest> Machine<M, KdRayContext<T>> for KdStackState {
     /// Processes one node; see [`Step`].
     #[inline(always)]
-    pub fn step<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &KdRayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-    ) -> Step {
+    fn step<O: Observer>(&mut self, mem: &M, ctx: &KdRayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
         let mut c = Cursor { node: self.node, t_min: self.t_min, t_max: self.t_max, len: self.len };
         let step = advance(&mut c, &mut self.stack, mem, ctx, q, obs);
         (self.node, self.t_min, self.t_max, self.len) = (c.node, c.t_min, c.t_max, c.len);
         step
     }
 
-    /// [`KdStackState::step`] until it is done, or until `max_steps` more steps have been taken,
-    /// as one loop with the cursor in locals
+    /// [`Machine::run`] as one loop with the cursor in locals
     /// (`docs/notes/*-benchmarks-one-loop.md`, "One loop per ray"): the same transitions in the
     /// same order, so the same answer and events.
     #[inline(always)]
-    pub fn run<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
-        &mut self,
-        mem: &M,
-        ctx: &KdRayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-        max_steps: u32,
-    ) {
+    fn run<O: Observer>(&mut self, mem: &M, ctx: &KdRayContext<T>, q: &mut QueryState, obs: &mut O, max_steps: u32) {
         let mut c = Cursor { node: self.node, t_min: self.t_min, t_max: self.t_max, len: self.len };
         let mut budget = max_steps;
         while advance(&mut c, &mut self.stack, mem, ctx, q, obs) != Step::Done && budget > 0 {

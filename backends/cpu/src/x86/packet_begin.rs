@@ -11,7 +11,7 @@
 //! [`PacketKernel::begin`](raytrail_core::wide::packet::PacketKernel::begin)'s bit for bit; lanes
 //! without an accepted ray hold what `PacketLanes::new` put there.
 
-use crate::avx_packet::{horizontal, Fold};
+use crate::x86::lanes::{horizontal, Fold};
 use raytrail_core::intersect::{RELIABLE_LIMIT, SLACK_SCALE};
 use raytrail_core::wide::packet::PacketLanes;
 use raytrail_core::Ray;
@@ -35,7 +35,7 @@ struct Bounds {
 /// 8, eight lanes per operation: `lanes` must be fresh from `PacketLanes::new`.
 ///
 /// # Safety
-/// The processor must run the AVX2 path ([`crate::avx::available`]); `N` must be a multiple of 8.
+/// The processor must run the AVX2 path ([`crate::x86::available`]); `N` must be a multiple of 8.
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 pub(crate) unsafe fn begin<const N: usize>(rays: &[Ray], scene_scale: f32, lanes: &mut PacketLanes<N>) {
@@ -197,7 +197,7 @@ mod tests {
     /// 32 rays with zero, infinite and NaN components, reversed intervals and unreliable slacks.
     #[test]
     fn lanes_made_eight_at_once_are_each_rays_own() {
-        if crate::avx::lacks_avx2_for("packet begin") {
+        if crate::x86::lacks_avx2_for("packet begin") {
             return;
         }
         let mut rng = Rng(0x6a09_e667_f3bc_c909);

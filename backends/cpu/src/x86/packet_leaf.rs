@@ -60,7 +60,7 @@ struct TriangleLanes {
 /// packet to a register, where `T` is the watertight test; `None` (nothing done) otherwise.
 ///
 /// # Safety
-/// The processor must run the AVX2 path ([`crate::avx::available`]).
+/// The processor must run the AVX2 path ([`crate::x86::available`]).
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 pub(crate) unsafe fn leaf<const W: usize, const N: usize, M, T, O>(
@@ -94,7 +94,7 @@ where
         let ld = |a: &[f32; N]| _mm256_loadu_ps(a.as_ptr().add(at));
         // Lanes without a ray of `mask` get a direction of (1, 1, 1): finite constants that no
         // test reads.
-        let in_mask = crate::avx_packet::lanes_of(live);
+        let in_mask = crate::x86::lanes::lanes_of(live);
         let dir = |a: usize| _mm256_blendv_ps(_mm256_set1_ps(1.0), ld(&lanes.dir[a]), in_mask);
         let o = &lanes.rays.origin;
         let mut r =
@@ -153,7 +153,7 @@ where
 /// direction of (1, 1, 1) and give finite constants that no test reads.
 ///
 /// # Safety
-/// The processor must run the AVX2 path ([`crate::avx::available`]).
+/// The processor must run the AVX2 path ([`crate::x86::available`]).
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn shear_lanes(d: [__m256; 3], o: [__m256; 3], r: &mut RayLanes) {
@@ -201,7 +201,7 @@ unsafe fn shear_lanes(d: [__m256; 3], o: [__m256; 3], r: &mut RayLanes) {
 /// One triangle (its nine floats from `v`) against the rays of `r`.
 ///
 /// # Safety
-/// The processor must run the AVX2 path ([`crate::avx::available`]); `v` must point to nine readable floats.
+/// The processor must run the AVX2 path ([`crate::x86::available`]); `v` must point to nine readable floats.
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn triangle(r: &RayLanes, v: *const f32) -> TriangleLanes {
@@ -293,8 +293,8 @@ unsafe fn triangle(r: &RayLanes, v: *const f32) -> TriangleLanes {
 #[cfg(test)]
 mod tests {
     use super::{shear_lanes, RayLanes};
-    use crate::avx::AvxKernel;
     use crate::test_rng::Rng;
+    use crate::x86::child_kernel::AvxKernel;
     use glam::Vec3;
     use raytrail_core::geometry::Triangle;
     use raytrail_core::intersect::{TriangleHit, Watertight};
@@ -325,7 +325,7 @@ mod tests {
     /// leaf's, with and without an observer.
     #[test]
     fn rays_in_lanes_match_the_single_ray_leaf() {
-        if crate::avx::lacks_avx2_for("packet leaf") {
+        if crate::x86::lacks_avx2_for("packet leaf") {
             return;
         }
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
@@ -379,7 +379,7 @@ mod tests {
                 &mut want,
                 &mut want_log,
             );
-            crate::avx_packet::AvxPacketKernel::leaf::<8, 32, _, Watertight, AvxKernel, _>(
+            crate::x86::packet::AvxPacketKernel::leaf::<8, 32, _, Watertight, AvxKernel, _>(
                 &mem,
                 first,
                 count as u32,
@@ -388,7 +388,7 @@ mod tests {
                 &mut got_log,
             );
             let mut no_obs: Vec<NoObserver> = (0..32).map(|_| NoObserver).collect();
-            crate::avx_packet::AvxPacketKernel::leaf::<8, 32, _, Watertight, AvxKernel, _>(
+            crate::x86::packet::AvxPacketKernel::leaf::<8, 32, _, Watertight, AvxKernel, _>(
                 &mem,
                 first,
                 count as u32,
@@ -419,7 +419,7 @@ mod tests {
     /// every sign: the axis order, the origin in that order and the shear.
     #[test]
     fn lane_constants_are_each_rays_own() {
-        if crate::avx::lacks_avx2_for("lane constants") {
+        if crate::x86::lacks_avx2_for("lane constants") {
             return;
         }
         use raytrail_core::intersect::TriangleTest;

@@ -11,7 +11,8 @@
 //!
 //! [`ReferencePacketKernel`]: raytrail_core::wide::packet::ReferencePacketKernel
 
-use crate::avx::AvxKernel;
+use super::child_kernel::AvxKernel;
+use super::lanes::{horizontal, lanes_of, Fold};
 use raytrail_core::intersect::{TriangleTest, FAR_PAD};
 use raytrail_core::method::Query;
 use raytrail_core::observe::Observer;
@@ -22,13 +23,10 @@ use raytrail_core::wide::traverse::WideRoot;
 use raytrail_core::wide::{ChildKernel, WideMemory, WideNode, EMPTY_CHILD};
 use raytrail_core::{Hit, Ray};
 use std::arch::x86_64::{
-    __m256, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps256_ps128,
-    _mm256_castps_si256, _mm256_castsi256_ps, _mm256_castsi256_si128, _mm256_cmp_ps, _mm256_cmpeq_epi32,
-    _mm256_cvtepi32_epi64, _mm256_extractf128_ps, _mm256_extracti128_si256, _mm256_loadu_ps, _mm256_max_ps,
-    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_epi64x,
-    _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_ps,
-    _mm_cvtss_f32, _mm_max_ps, _mm_max_ss, _mm_min_ps, _mm_min_ss, _mm_movehl_ps, _mm_shuffle_ps, _CMP_GT_OQ,
-    _CMP_LE_OQ,
+    __m256, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps_si256,
+    _mm256_castsi256_si128, _mm256_cmp_ps, _mm256_cvtepi32_epi64, _mm256_extracti128_si256, _mm256_loadu_ps,
+    _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_si256, _mm256_set1_epi64x,
+    _mm256_set1_ps, _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_ps, _CMP_GT_OQ, _CMP_LE_OQ,
 };
 
 /// The packet kernel of [`trace_batch`], used only there (and by the tests, after their own AVX2
@@ -47,18 +45,18 @@ impl PacketKernel for AvxPacketKernel {
         }
     }
 
-    /// Eight lanes per operation ([`crate::avx_packet_begin`]).
+    /// Eight lanes per operation ([`crate::x86::packet_begin`]).
     #[inline(always)]
     fn begin<const N: usize>(rays: &[Ray], scene_scale: f32, lanes: &mut PacketLanes<N>) {
         if N % 8 == 0 {
             // SAFETY: as `test`.
-            unsafe { crate::avx_packet_begin::begin(rays, scene_scale, lanes) }
+            unsafe { crate::x86::packet_begin::begin(rays, scene_scale, lanes) }
         } else {
             ReferencePacketKernel::begin(rays, scene_scale, lanes)
         }
     }
 
-    /// With the rays in the lanes ([`crate::avx_packet_leaf`]) where the test is the watertight
+    /// With the rays in the lanes ([`crate::x86::packet_leaf`]) where the test is the watertight
     /// one; otherwise each ray alone.
     #[inline(always)]
     fn leaf<const W: usize, const N: usize, M, T, K, O>(
@@ -75,7 +73,7 @@ impl PacketKernel for AvxPacketKernel {
         O: Observer,
     {
         // SAFETY: as `test`.
-        if unsafe { crate::avx_packet_leaf::leaf::<W, N, M, T, O>(mem, first, count, mask, lanes, obs) }.is_none() {
+        if unsafe { crate::x86::packet_leaf::leaf::<W, N, M, T, O>(mem, first, count, mask, lanes, obs) }.is_none() {
             ReferencePacketKernel::leaf::<W, N, M, T, K, O>(mem, first, count, mask, lanes, obs);
         }
     }
@@ -92,7 +90,7 @@ impl PacketKernel for AvxPacketKernel {
 }
 
 /// # Safety
-/// The processor must run the AVX2 path ([`crate::avx::available`]); `N` must be a multiple of 8.
+/// The processor must run the AVX2 path ([`crate::x86::available`]); `N` must be a multiple of 8.
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn reaching_avx<const N: usize>(key: f32, p: &PacketRays<N>, mask: u64) -> u64 {
@@ -106,7 +104,7 @@ unsafe fn reaching_avx<const N: usize>(key: f32, p: &PacketRays<N>, mask: u64) -
 }
 
 /// # Safety
-/// The processor must run the AVX2 path ([`crate::avx::available`]); `W` must be 8 and `N` a multiple of 8.
+/// The processor must run the AVX2 path ([`crate::x86::available`]); `W` must be 8 and `N` a multiple of 8.
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &PacketRays<N>, mask: u64) -> PacketHits<W> {
@@ -150,7 +148,7 @@ unsafe fn test_avx<const W: usize, const N: usize>(node: &WideNode<W>, p: &Packe
 }
 
 /// [`test_avx`] one ray at a time, all eight children per operation: each ray's test is the
-/// single-ray AVX test's (`crate::avx`), the child's key the least entry distance over the rays in
+/// single-ray AVX test's (`crate::x86::child_kernel`), the child's key the least entry distance over the rays in
 /// lane order (`vminps(new, key)` keeps `key` on a tie, as the reference keeps the first).
 ///
 /// # Safety
@@ -213,50 +211,6 @@ unsafe fn slab_axis(
     (_mm256_max_ps(tn, t_enter), _mm256_min_ps(tf, t_exit))
 }
 
-/// The lanes picked by the low 8 bits of `group` (bit `k`: lane `k`), as an all-ones mask per
-/// picked lane.
-///
-/// # Safety
-/// The processor must support AVX2.
-#[target_feature(enable = "avx2")]
-#[inline]
-pub(crate) unsafe fn lanes_of(group: u32) -> __m256 {
-    // Bit k of a lane's own constant.
-    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-    _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(group as i32), bits), bits))
-}
-
-/// Which way [`horizontal`] folds.
-#[derive(Clone, Copy)]
-pub(crate) enum Fold {
-    /// To the least lane.
-    Min,
-    /// To the greatest lane.
-    Max,
-}
-
-/// The least or greatest of `v`'s eight lanes (none is NaN).
-///
-/// # Safety
-/// The processor must support AVX.
-#[target_feature(enable = "avx")]
-#[inline]
-pub(crate) unsafe fn horizontal(v: __m256, fold: Fold) -> f32 {
-    let (low, high) = (_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
-    match fold {
-        Fold::Min => {
-            let h = _mm_min_ps(low, high);
-            let h = _mm_min_ps(h, _mm_movehl_ps(h, h));
-            _mm_cvtss_f32(_mm_min_ss(h, _mm_shuffle_ps::<1>(h, h)))
-        }
-        Fold::Max => {
-            let h = _mm_max_ps(low, high);
-            let h = _mm_max_ps(h, _mm_movehl_ps(h, h));
-            _mm_cvtss_f32(_mm_max_ss(h, _mm_shuffle_ps::<1>(h, h)))
-        }
-    }
-}
-
 /// The children some ray of the packet may hit (a bit per slot): the others are culled by the
 /// interval test, all eight at once. Packets whose reciprocal directions differ in sign on an axis
 /// or are not finite keep every non-empty child.
@@ -298,7 +252,7 @@ unsafe fn cull<const W: usize, const N: usize>(node: &WideNode<W>, p: &PacketRay
 /// [`trace_wide_packets`] with the AVX2 child kernel and packet kernel, compiled for AVX2.
 ///
 /// # Safety
-/// The processor must run the AVX2 path ([`crate::avx::available`]).
+/// The processor must run the AVX2 path ([`crate::x86::available`]).
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer + Default>(
     mem: &M,
@@ -324,7 +278,7 @@ mod tests {
     /// reaching a key alike.
     #[test]
     fn avx_packet_kernel_matches_the_reference() {
-        if crate::avx::lacks_avx2_for("packet kernel") {
+        if crate::x86::lacks_avx2_for("packet kernel") {
             return;
         }
         let mut rng = Rng(0x2545_f491_4f6c_dd1d);

@@ -1,23 +1,9 @@
-//! The AVX2 path of the wide traversal, chosen at run time: an 8-wide node's boxes in one 256-bit
-//! operation per step, three or more hit children ordered by rank, and the whole batch loop
-//! compiled for AVX2 (so the 4-wide SSE code and the triangle tests get its three-operand encoding
-//! too) and for the bit instructions every AVX2 processor has (BMI1, BMI2, LZCNT, POPCNT): without
-//! them a mask's `count_ones` was a multiply sequence on the path to every node's order, and each
-//! `trailing_zeros` a branchy `bsf` (1.01-1.03 on most ray sets;
-//! `docs/notes/*-benchmarks-leaf-blocks.md`, "Triangle blocks that carry their primitive ids").
-//! Every answer and every order is the reference kernel's bit for bit; the tests below hold them to
-//! that on adversarial values.
+//! The AVX2 child kernel of every wide walk: an 8-wide node's boxes in one 256-bit operation per
+//! plane, three or more hit children ordered by rank; the 4-wide SSE code and the triangle tests
+//! compile with AVX2's three-operand encoding inside the walks that use it.
 
-use raytrail_core::intersect::{SlabRay, TriangleTest, FAR_PAD};
-use raytrail_core::key::Key;
-use raytrail_core::method::Query;
-use raytrail_core::observe::Observer;
-use raytrail_core::wide::keyed::WideKeyedMemory;
-use raytrail_core::wide::ray_stream::trace_wide_streams;
-use raytrail_core::wide::trail::trace_wide_trail_batch;
-use raytrail_core::wide::traverse::{trace_wide_batch, WideRoot};
-use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, StreamRay, WideMemory, WideNode};
-use raytrail_core::{Hit, Ray};
+use raytrail_core::intersect::{SlabRay, FAR_PAD};
+use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, StreamRay, WideNode};
 use std::arch::x86_64::{
     _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_ps, _mm256_castps_si256,
     _mm256_cmp_ps, _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps,
@@ -26,31 +12,11 @@ use std::arch::x86_64::{
     _CMP_LE_OQ, _CMP_LT_OQ,
 };
 
-/// Whether this processor runs the AVX2 path: AVX2 and the bit instructions the path is compiled
-/// for with it (every AVX2 processor has them; the check costs nothing per ray).
-pub(crate) fn available() -> bool {
-    std::arch::is_x86_feature_detected!("avx2")
-        && std::arch::is_x86_feature_detected!("bmi1")
-        && std::arch::is_x86_feature_detected!("bmi2")
-        && std::arch::is_x86_feature_detected!("lzcnt")
-        && std::arch::is_x86_feature_detected!("popcnt")
-}
-
-/// For a test of an AVX2 path: whether this processor lacks AVX2, in which case the test is said
-/// to be skipped (`what`: the test's name in the message) and should return.
-#[cfg(test)]
-pub(crate) fn lacks_avx2_for(what: &str) -> bool {
-    let lacks = !available();
-    if lacks {
-        eprintln!("SKIPPED the AVX2 {what} test: this processor has no AVX2");
-    }
-    lacks
-}
-
 /// The fast kernel with 8-wide nodes tested in one AVX operation per plane and ordered by
-/// [`order_by_rank`] where three or more children are hit. Private to this
-/// module and used only inside [`trace_batch`], whose caller has checked for AVX2: that is what
-/// makes its unchecked AVX calls sound (a check per node cost 2% of a ray's time).
+/// [`order_by_rank`] where three or more children are hit. Used only inside this folder's walks
+/// (`single_ray`, `stream`, `packet`), each of whose callers has checked for AVX2
+/// ([`super::available`]): that is what makes its unchecked AVX calls sound (a check per node cost
+/// 2% of a ray's time).
 pub(crate) struct AvxKernel;
 
 impl ChildKernel for AvxKernel {
@@ -59,7 +25,7 @@ impl ChildKernel for AvxKernel {
     #[inline(always)]
     fn test<const W: usize>(node: &WideNode<W>, slab: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
         if W % 8 == 0 {
-            // SAFETY: only `trace_batch` uses this kernel, and only where the AVX2 path runs.
+            // SAFETY: only this folder's walks use this kernel, and only where the AVX2 path runs.
             unsafe { test_avx(node, slab, tmin, tmax) }
         } else {
             FastKernel::test(node, slab, tmin, tmax)
@@ -77,7 +43,7 @@ impl ChildKernel for AvxKernel {
         counts: &mut [u32; W],
     ) {
         if W == 8 {
-            // SAFETY: only `trace_batch` and `trace_streams` use this kernel, where AVX2 runs.
+            // SAFETY: only this folder's walks use this kernel, and only where the AVX2 path runs.
             unsafe { stream_node_avx(node, live, rays, masks, t_enter, keys, counts) }
         } else {
             FastKernel::stream_node(node, live, rays, masks, t_enter, keys, counts)
@@ -87,7 +53,7 @@ impl ChildKernel for AvxKernel {
     #[inline(always)]
     fn order<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
         if W == 8 && hits.mask.count_ones() > 2 {
-            // SAFETY: only `trace_batch` uses this kernel, and only where the AVX2 path runs.
+            // SAFETY: only this folder's walks use this kernel, and only where the AVX2 path runs.
             unsafe { order_by_rank(hits, order) }
         } else {
             FastKernel::order(hits, order)
@@ -192,7 +158,7 @@ unsafe fn stream_node_avx<const W: usize>(
 /// network compiled to two branches per compare-and-swap here.
 ///
 /// # Safety
-/// The processor must run the AVX2 path ([`crate::avx::available`]).
+/// The processor must run the AVX2 path ([`crate::x86::available`]).
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 #[inline]
 unsafe fn order_by_rank<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W]) -> usize {
@@ -222,72 +188,13 @@ unsafe fn order_by_rank<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W
     }
     hits.mask.count_ones() as usize
 }
-
-/// [`trace_wide_batch`] with [`AvxKernel`], compiled for AVX2.
-///
-/// # Safety
-/// The processor must run the AVX2 path ([`available`]).
-#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
-pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
-    mem: &M,
-    root: WideRoot,
-    rays: &[Ray],
-    hits: &mut [Hit],
-    query: Query,
-    obs: &mut O,
-) {
-    trace_wide_batch::<W, M, T, AvxKernel, O>(mem, root, rays, hits, query, obs);
-}
-
-/// [`trace_wide_streams`] (streams of rays) with [`AvxKernel`], compiled for AVX2.
-///
-/// # Safety
-/// The processor must run the AVX2 path ([`available`]).
-#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
-pub(crate) unsafe fn trace_streams<
-    const W: usize,
-    M: WideMemory<W> + ?Sized,
-    T: TriangleTest,
-    O: Observer + Default,
->(
-    mem: &M,
-    root: WideRoot,
-    rays: &[Ray],
-    hits: &mut [Hit],
-    query: Query,
-    done: impl FnMut(usize, O),
-) {
-    trace_wide_streams::<W, M, T, AvxKernel, O>(mem, root, rays, hits, query, done);
-}
-
-/// [`trace_wide_trail_batch`] (the keyed, stackless traversal) with [`AvxKernel`], compiled for
-/// AVX2.
-///
-/// # Safety
-/// The processor must run the AVX2 path ([`available`]).
-#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
-pub(crate) unsafe fn trace_keyed_batch<
-    const W: usize,
-    K: Key,
-    M: WideKeyedMemory<W> + ?Sized,
-    T: TriangleTest,
-    O: Observer,
->(
-    mem: &M,
-    root: WideRoot,
-    rays: &[Ray],
-    hits: &mut [Hit],
-    query: Query,
-    obs: &mut O,
-) {
-    trace_wide_trail_batch::<W, K, M, T, AvxKernel, O>(mem, root, rays, hits, query, obs);
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::lacks_avx2_for;
     use super::*;
     use glam::Vec3;
     use raytrail_core::wide::{ReferenceKernel, WideChild};
+    use raytrail_core::Ray;
 
     /// Ordinary values with zeros of both signs, infinities, NaN, a subnormal and exact repeats.
     struct Values(u64);
