@@ -71,6 +71,23 @@ impl Quality {
     }
 }
 
+/// Why Embree could not build a scene: the step that failed and Embree's error code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EmbreeError {
+    /// The step: "cannot create a device", "the build failed", ...
+    pub step: &'static str,
+    /// Embree's error code.
+    pub code: embree3::Error,
+}
+
+impl std::fmt::Display for EmbreeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "embree: {}: {:?}", self.step, self.code)
+    }
+}
+
+impl std::error::Error for EmbreeError {}
+
 /// An Embree scene over a raytrail scene: a bench target.
 pub struct Embree {
     scene: EmbreeScene<'static>,
@@ -80,8 +97,8 @@ pub struct Embree {
 impl Embree {
     /// Builds the Embree scene over `scene` at `quality` with `threads` build threads; returns it
     /// and what the build cost.
-    pub fn new(scene: &Scene, threads: usize, quality: Quality) -> Result<(Self, Built), String> {
-        let fail = |what: &str, e: embree3::Error| format!("embree: {what}: {e:?}");
+    pub fn new(scene: &Scene, threads: usize, quality: Quality) -> Result<(Self, Built), EmbreeError> {
+        let fail = |step: &'static str, code: embree3::Error| EmbreeError { step, code };
         let config = Config { threads: u32::try_from(threads).unwrap_or(0), ..Config::default() };
         let device = Device::with_config(config).map_err(|e| fail("cannot create a device", e))?;
         let allocated = Arc::new(AtomicIsize::new(0));

@@ -52,7 +52,8 @@ pub fn build(names: &[String], scene: &Scene, pool: &rayon::ThreadPool) -> Resul
     for name in names {
         #[cfg(feature = "embree")]
         if let Some(quality) = embree::Quality::from_name(name) {
-            let (target, b) = embree::Embree::new(scene, pool.current_num_threads(), quality)?;
+            let (target, b) =
+                embree::Embree::new(scene, pool.current_num_threads(), quality).map_err(|e| e.to_string())?;
             targets.push(Box::new(target));
             built.push(b);
             continue;
