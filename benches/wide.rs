@@ -33,10 +33,10 @@ use std::time::Duration;
 const SCENES: &[&str] = &["bunny.obj", "sponza.obj"];
 const METHODS: &[Method] = &[
     Method::Bvh2(Bvh2Method::Stack),
-    Method::Wide(WideMethod::Bvh4),
-    Method::Wide(WideMethod::Bvh8),
-    Method::Wide(WideMethod::Bvh4Naive),
-    Method::Wide(WideMethod::Bvh8Sah),
+    Method::Wide(WideMethod::BVH4),
+    Method::Wide(WideMethod::BVH8),
+    Method::Wide(WideMethod::BVH4_NAIVE),
+    Method::Wide(WideMethod::BVH8_SAH),
 ];
 /// Length of an ambient-occlusion ray as a fraction of the scene's diagonal (the CLI bench's).
 const AO_RADIUS: f32 = 0.05;
@@ -93,18 +93,20 @@ impl Variant {
 
 /// The variants traced for `query`: sorted any-hit only where it differs from the default.
 fn variants(query: Query) -> Vec<Variant> {
-    use WideMethod::{Bvh4, Bvh4Naive, Bvh8, Bvh8Sah};
     let mut v = vec![
         Variant::Binary,
-        Variant::Wide(Bvh4, Kernel::Fast),
-        Variant::Wide(Bvh8, Kernel::Fast),
-        Variant::Wide(Bvh4Naive, Kernel::Fast),
-        Variant::Wide(Bvh8Sah, Kernel::Fast),
-        Variant::Wide(Bvh4, Kernel::OneTri),
-        Variant::Wide(Bvh8, Kernel::OneTri),
+        Variant::Wide(WideMethod::BVH4, Kernel::Fast),
+        Variant::Wide(WideMethod::BVH8, Kernel::Fast),
+        Variant::Wide(WideMethod::BVH4_NAIVE, Kernel::Fast),
+        Variant::Wide(WideMethod::BVH8_SAH, Kernel::Fast),
+        Variant::Wide(WideMethod::BVH4, Kernel::OneTri),
+        Variant::Wide(WideMethod::BVH8, Kernel::OneTri),
     ];
     if query.is_any() {
-        v.extend([Variant::Wide(Bvh4, Kernel::SortedAny), Variant::Wide(Bvh8, Kernel::SortedAny)]);
+        v.extend([
+            Variant::Wide(WideMethod::BVH4, Kernel::SortedAny),
+            Variant::Wide(WideMethod::BVH8, Kernel::SortedAny),
+        ]);
     }
     v
 }

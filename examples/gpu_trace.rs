@@ -34,7 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect();
 
     let cpu_hits = Tracer::builder()
-        .method(Method::Wide(raytrail::core::method::WideMethod::Bvh8))
+        .method(Method::Wide(raytrail::core::method::WideMethod::BVH8))
         .build_scene(&scene)?
         .intersect(&rays)?;
 
@@ -46,7 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     println!("adapter: {}", backend.adapter());
-    let method = Method::Wide(raytrail::core::method::WideMethod::Bvh8);
+    let method = Method::Wide(raytrail::core::method::WideMethod::BVH8);
     let prepared = Arc::new(PreparedScene::new(&scene, Builder::Best.build(&scene)?, &[method])?);
     let gpu_scene = backend.prepare(prepared)?;
     let mut gpu_hits = vec![Hit::MISS; rays.len()];

@@ -1,4 +1,4 @@
-// Method bvh8-stream: bvh8's tree walked by streams of WIDE_STREAM consecutive rays of the batch
+// Method bvh8-lists: bvh8's tree walked by streams of WIDE_STREAM consecutive rays of the batch
 // (`wide::ray_stream`), a stream to a workgroup. Invocation w owns the stream's rays
 // 32w .. 32w + 31, one bit each in every ray set, so that it writes its word of a set alone. The
 // rule is the core's, step for step:

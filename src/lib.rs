@@ -26,7 +26,7 @@
 //! | rays | method |
 //! |---|---|
 //! | camera rays, shadow rays toward one light (coherent) | `bvh8-sah-packet`, or `kd-stack` for camera rays in rooms |
-//! | bounces of a path tracer, ambient occlusion (incoherent) | `bvh8-sah-stream` in large batches, `bvh8-sah` otherwise |
+//! | bounces of a path tracer, ambient occlusion (incoherent) | `bvh8-sah-lists` in large batches, `bvh8-sah` otherwise |
 //! | one ray at a time, or a few | `bvh8-sah` (any hit: `bvh8`) |
 //! | no stack memory (GPUs, hardware) | `bvh4-hash`, `hash` (Binder & Keller 2016) |
 //!
@@ -43,7 +43,7 @@
 //! use raytrail::prelude::*;
 //! # fn main() -> Result<(), raytrail::Error> {
 //! let scene = raytrail::core::scene::Scene::from_indexed(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]])?;
-//! let method = Method::Wide(WideMethod::Bvh8);
+//! let method = Method::Wide(WideMethod::BVH8);
 //! let prepared = PreparedScene::new(&scene, Builder::Sah.build(&scene)?, &[method])?;
 //! let backend = CpuBackend::new();
 //! let cpu_scene = backend.prepare(Arc::new(prepared))?;

@@ -23,9 +23,9 @@ use std::sync::Arc;
 /// rays (incoherent rays, small batches), packets (camera rays, shadow rays toward one light),
 /// streams (incoherent closest-hit rays in large batches).
 pub const AUTO_WALKS: [Method; 3] = [
-    Method::Wide(WideMethod::Bvh8Sah),
-    Method::Wide(WideMethod::Bvh8SahPacket),
-    Method::Wide(WideMethod::Bvh8SahStream),
+    Method::Wide(WideMethod::BVH8_SAH),
+    Method::Wide(WideMethod::BVH8_SAH_PACKET),
+    Method::Wide(WideMethod::BVH8_SAH_LISTS),
 ];
 
 /// Batches of fewer rays are traced with the first of [`AUTO_WALKS`] without timing the others:

@@ -72,12 +72,12 @@ fn a_tracer_from_arrays_answers_as_the_stack_method_in_every_form() {
 fn a_named_method_and_thread_count_are_used_for_every_batch() {
     let scene = generated_scene("sphereflake").scene;
     let rays = primary(&scene, 64, 48);
-    let method = Method::Wide(WideMethod::Bvh4Hash);
+    let method = Method::Wide(WideMethod::BVH4_HASH);
     let tracer = Tracer::builder().method(method).threads(1).tree_builder(Builder::Sah).build_scene(&scene).unwrap();
     assert_eq!(tracer.method_for(&rays, Query::Closest).unwrap(), method);
     // Only that method's tables were built.
     assert!(tracer.prepared().check_prepared(method).is_ok());
-    assert!(tracer.prepared().check_prepared(Method::Wide(WideMethod::Bvh8)).is_err());
+    assert!(tracer.prepared().check_prepared(Method::Wide(WideMethod::BVH8)).is_err());
     let want = stack_hits(&scene, &rays, Query::Closest);
     assert!(tracer.intersect(&rays).unwrap().iter().zip(&want).all(|(a, b)| a.same_as(b)));
 }
@@ -150,7 +150,7 @@ fn a_tree_built_for_other_triangles_is_rejected() {
         *v += Vec3::splat(10.0);
     }
     let moved = Scene::new(moved).unwrap();
-    for method in [Method::Bvh2(Bvh2Method::Stack), Method::Wide(WideMethod::Bvh8)] {
+    for method in [Method::Bvh2(Bvh2Method::Stack), Method::Wide(WideMethod::BVH8)] {
         match PreparedScene::new(&moved, bvh.clone(), &[method]) {
             Err(raytrail::core::Error::TreeMismatch { .. }) => {}
             other => panic!("{method}: expected TreeMismatch, got {:?}", other.map(|_| "a prepared scene")),

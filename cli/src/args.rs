@@ -13,8 +13,9 @@ use std::path::Path;
 const AFTER_HELP: &str = "\
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
          kd-stack, kd-restart, kd-push-down, kd-short-stack, kd-packet (kd-tree);
-         bvh4, bvh8, bvh4-naive, bvh8-sah, bvh8-packet, bvh8-stream, bvh4-hash, bvh8-sah-packet,
-         bvh8-sah-stream (wide BVH);
+         bvh4, bvh8, bvh4-naive, bvh8-sah, bvh8-packet, bvh8-lists, bvh4-hash, bvh8-sah-packet,
+         bvh8-sah-lists (wide BVH; bvh8-stream and bvh8-sah-stream, the lists' former names, still
+         work);
          stream (ray stream, Garanzha & Loop);
          auto (trace's default; bench --methods): the fastest of bvh8, bvh8-packet, kd-stack, stack
          and stream

@@ -7,6 +7,7 @@ use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use raytrail_core::kd::traverse::packets::packets;
 use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, RestartPolicy, PACKET_WIDTH};
 use raytrail_core::key::{Key, KeyWidth};
+use raytrail_core::method::WideWalk;
 use raytrail_core::method::{KdMethod, Method, Query, StreamMethod, WideMethod};
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
@@ -78,7 +79,7 @@ impl SerialBackend {
                     })
                     .collect())
             }
-            Method::Wide(m) if m.keyed() => {
+            Method::Wide(m) if m.walk() == WideWalk::Trail => {
                 let root = scene.wide_root(m)?;
                 let (mem, keys) = scene.wide_keyed(m)?;
                 Ok(match keys {
@@ -110,12 +111,12 @@ impl SerialBackend {
         query: Query,
         method: WideMethod,
     ) -> Vec<Traced> {
-        if method.shares_walks() {
+        if method.walk().shares_walks() {
             let mut hits = vec![Hit::MISS; rays.len()];
             let mut observers = Vec::with_capacity(rays.len());
             let done = |i, o| observers.push((i, o));
             type Obs = Both<Counters, Recorder>;
-            if method.streams() {
+            if method.walk() == WideWalk::RayLists {
                 trace_wide_streams::<W, _, T, ReferenceKernel, Obs>(mem, root, rays, &mut hits, query, done);
             } else {
                 trace_wide_packets::<W, _, T, ReferenceKernel, ReferencePacketKernel, Obs>(
@@ -138,7 +139,7 @@ impl SerialBackend {
 }
 
 impl SerialBackend {
-    /// The keyed, stackless wide traversal with the reference kernel, one ray at a time.
+    /// The stackless trail walk with the reference kernel, one ray at a time.
     fn keyed<K: Key, M: WideKeyedMemory<4>, T: TriangleTest>(
         mem: &M,
         root: WideRoot,

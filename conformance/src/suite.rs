@@ -72,7 +72,7 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
             let s = generated_scene("degenerate_stack");
             let bvh = sah(&s);
             assert_eq!(bvh.stats().key_width, KeyWidth::W64, "depth {} should need 64-bit keys", bvh.stats().depth);
-            let wide = WideBvh::<4>::build(&bvh, s.scene.triangles(), WideMethod::Bvh4Hash.collapse()).expect("bvh4");
+            let wide = WideBvh::<4>::build(&bvh, s.scene.triangles(), WideMethod::BVH4_HASH.collapse()).expect("bvh4");
             let depth = wide.stats().depth;
             assert_eq!(wide_key_width::<4>(depth), Some(KeyWidth::W64), "4-wide depth {depth} should need 64-bit keys");
             check_scene(backend, &s, |_| bvh.clone(), GENERATED_RAYS);

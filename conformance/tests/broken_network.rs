@@ -126,12 +126,12 @@ macro_rules! every_exchange_caught {
 
 #[test]
 fn every_dropped_exchange_of_either_network_is_caught() {
-    every_exchange_caught!(WideMethod::Bvh4; 0, 1, 2, 3, 4, 5);
-    every_exchange_caught!(WideMethod::Bvh8; 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23);
+    every_exchange_caught!(WideMethod::BVH4; 0, 1, 2, 3, 4, 5);
+    every_exchange_caught!(WideMethod::BVH8; 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23);
 }
 
 #[test]
 fn the_intact_network_passes_the_same_check() {
-    assert_eq!(caught::<{ usize::MAX }>(WideMethod::Bvh4), 0);
-    assert_eq!(caught::<{ usize::MAX }>(WideMethod::Bvh8), 0);
+    assert_eq!(caught::<{ usize::MAX }>(WideMethod::BVH4), 0);
+    assert_eq!(caught::<{ usize::MAX }>(WideMethod::BVH8), 0);
 }

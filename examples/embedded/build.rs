@@ -45,7 +45,7 @@ fn main() {
     // parent/sibling needs its own layout and only hash-resume the hash over every node. Every
     // kd method reads the one kd-tree; the 4-wide BVH (Guthe's pull-up) is the wide tree baked.
     let mut methods = Method::BVH2.to_vec();
-    methods.extend([Method::Kd(KdMethod::Stack), Method::Wide(WideMethod::Bvh4), Method::Wide(WideMethod::Bvh4Hash)]);
+    methods.extend([Method::Kd(KdMethod::Stack), Method::Wide(WideMethod::BVH4), Method::Wide(WideMethod::BVH4_HASH)]);
     let prepared = PreparedScene::new(&scene, bvh, &methods).expect("the sphereflake prepares");
 
     let uncles = prepared.layout(Bvh2Method::Uncle).expect("uncle layout prepared");
@@ -120,10 +120,10 @@ fn main() {
     float(w, "Scene scale of the kd methods (their box's largest magnitude).", "KD_SCENE_SCALE", kd_root.scene_scale);
     floats(w, "Lower corner of the box the kd-tree partitions.", "KD_MIN", kd_root.lo.to_array());
     floats(w, "Upper corner of the box the kd-tree partitions.", "KD_MAX", kd_root.hi.to_array());
-    let WideTree::Four(wide) = prepared.wide_tree(WideMethod::Bvh4).expect("wide tree") else {
+    let WideTree::Four(wide) = prepared.wide_tree(WideMethod::BVH4).expect("wide tree") else {
         unreachable!("bvh4 is four wide")
     };
-    let wide_root = prepared.wide_root(WideMethod::Bvh4).expect("wide root");
+    let wide_root = prepared.wide_root(WideMethod::BVH4).expect("wide root");
     konst(w, "Nodes of the 4-wide BVH (128 B each).", "WIDE_NODES", "usize", wide.nodes().len());
     konst(w, "Blocks of four triangles of the 4-wide BVH.", "WIDE_BLOCKS", "usize", wide.blocks().len());
     konst(w, "Primitive ids of the 4-wide BVH's triangle positions.", "WIDE_PRIMS", "usize", wide.prims().len());
@@ -175,7 +175,7 @@ fn write_kd(out: &Path, p: &PreparedScene) -> usize {
 /// Writes the 4-wide BVH's nodes, triangle blocks and primitive ids (the traversal reads
 /// triangles four at a time, so the blocks are the only copy of them); returns their bytes.
 fn write_wide(out: &Path, p: &PreparedScene) -> usize {
-    let WideTree::Four(wide) = p.wide_tree(WideMethod::Bvh4).expect("wide tree") else {
+    let WideTree::Four(wide) = p.wide_tree(WideMethod::BVH4).expect("wide tree") else {
         unreachable!("bvh4 is four wide")
     };
     let nodes: &[u8] = bytemuck::cast_slice(wide.nodes());
@@ -282,7 +282,7 @@ fn footprint(p: &PreparedScene, uncles: &BinaryLayout, parents: &BinaryLayout, h
         kd.tree.nodes().len(),
         kd.tree.stats().depth
     ));
-    if let Ok(WideTree::Four(wide)) = p.wide_tree(WideMethod::Bvh4) {
+    if let Ok(WideTree::Four(wide)) = p.wide_tree(WideMethod::BVH4) {
         let (wn, wb, wp) = (wide.nodes().len() * 128, wide.blocks().len() * 144, wide.prims().len() * 4);
         total += wn + wb + wp;
         warn(format!(

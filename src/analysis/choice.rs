@@ -15,8 +15,8 @@ use raytrail_core::Error;
 /// by more than they could gain (bvh4 trails bvh8, kd-short-stack and kd-packet trail or tie
 /// kd-stack, the stackless BVH2 methods tie or trail stack on this CPU).
 pub const CANDIDATES: [Method; 5] = [
-    Method::Wide(WideMethod::Bvh8),
-    Method::Wide(WideMethod::Bvh8Packet),
+    Method::Wide(WideMethod::BVH8),
+    Method::Wide(WideMethod::BVH8_PACKET),
     Method::Kd(KdMethod::Stack),
     Method::Bvh2(Bvh2Method::Stack),
     Method::Stream(StreamMethod::Frustum8),

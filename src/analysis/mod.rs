@@ -133,11 +133,11 @@ pub fn maker(part: Part) -> Method {
         Part::Hash => Method::Bvh2(Bvh2Method::Hash),
         Part::FullHash => Method::Bvh2(Bvh2Method::HashResume),
         Part::Kd => Method::Kd(KdMethod::Stack),
-        Part::Wide4 => Method::Wide(WideMethod::Bvh4),
-        Part::Wide4Hash => Method::Wide(WideMethod::Bvh4Hash),
-        Part::Wide8 => Method::Wide(WideMethod::Bvh8),
-        Part::Wide4Naive => Method::Wide(WideMethod::Bvh4Naive),
-        Part::Wide8Sah => Method::Wide(WideMethod::Bvh8Sah),
+        Part::Wide4 => Method::Wide(WideMethod::BVH4),
+        Part::Wide4Hash => Method::Wide(WideMethod::BVH4_HASH),
+        Part::Wide8 => Method::Wide(WideMethod::BVH8),
+        Part::Wide4Naive => Method::Wide(WideMethod::BVH4_NAIVE),
+        Part::Wide8Sah => Method::Wide(WideMethod::BVH8_SAH),
         Part::Levels => Method::Stream(StreamMethod::Frustum8),
     }
 }

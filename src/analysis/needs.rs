@@ -168,18 +168,18 @@ mod tests {
         ])
         .unwrap();
         assert_eq!(shared_vertices(&s), (2, 7));
-        let needs = Needs::decide(&s, 3, &[Method::Wide(WideMethod::Bvh8)], None);
+        let needs = Needs::decide(&s, 3, &[Method::Wide(WideMethod::BVH8)], None);
         assert!(needs.f64_fallback.needed);
         // A soup: nothing shared, no fallback needed.
         let soup = Scene::new(vec![s.triangles()[0], s.triangles()[2]]).unwrap();
         assert_eq!(shared_vertices(&soup), (0, 6));
-        assert!(!Needs::decide(&soup, 1, &[Method::Wide(WideMethod::Bvh8)], None).f64_fallback.needed);
+        assert!(!Needs::decide(&soup, 1, &[Method::Wide(WideMethod::BVH8)], None).f64_fallback.needed);
     }
 
     #[test]
     fn keys_hash_and_mask_follow_the_chosen_methods_and_the_depth() {
         let s = Scene::new(vec![tri([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])]).unwrap();
-        let wide = [Method::Wide(WideMethod::Bvh8), Method::Kd(KdMethod::Stack)];
+        let wide = [Method::Wide(WideMethod::BVH8), Method::Kd(KdMethod::Stack)];
         let hash = [Method::Bvh2(Bvh2Method::Hash)];
         // Deep trees need 64-bit keys only where a chosen method keeps a key.
         assert!(!Needs::decide(&s, 40, &wide, None).keys64.needed);

@@ -49,7 +49,7 @@ mod tests {
 
     #[test]
     fn one_kernel_per_distinct_method_and_query() {
-        let bvh8 = Method::Wide(WideMethod::Bvh8);
+        let bvh8 = Method::Wide(WideMethod::BVH8);
         let kd = Method::Kd(KdMethod::Stack);
         let chosen = [
             (kd, Query::Closest),

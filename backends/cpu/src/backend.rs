@@ -1,6 +1,7 @@
 use crate::chunk::Chunk;
 use rayon::prelude::*;
 use raytrail_core::method::Method;
+use raytrail_core::method::WideWalk;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
@@ -18,7 +19,7 @@ const TASK_RAYS: usize = GROUPING_RAYS;
 /// Rays per parallel task for `method`: [`TASK_RAYS`], or for a stream method one stream, so that
 /// each task traces a whole one.
 fn chunk_rays(method: Method) -> usize {
-    if method.wide().is_some_and(|m| m.streams()) {
+    if method.wide().is_some_and(|m| m.walk() == WideWalk::RayLists) {
         STREAM_RAYS
     } else {
         TASK_RAYS

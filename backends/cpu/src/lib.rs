@@ -10,11 +10,11 @@ mod backend;
 mod bvh2;
 mod chunk;
 mod kd;
-mod keyed;
 mod record;
 mod stream;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod test_rng;
+mod trail;
 mod wide;
 #[cfg(target_arch = "x86_64")]
 mod x86;

@@ -17,7 +17,7 @@ use raytrail_core::wide::traverse::WideRoot;
 use raytrail_core::wide::FastKernel;
 use raytrail_core::{Error, Hit, Ray};
 
-/// Traces one chunk with the keyed `method`.
+/// Traces one chunk with the trail walk `method`.
 pub(crate) fn trace_chunk(
     scene: &PreparedScene,
     method: WideMethod,
@@ -32,7 +32,7 @@ pub(crate) fn trace_chunk(
     }
 }
 
-/// A keyed chunk waiting for its triangle test.
+/// A trail chunk waiting for its triangle test.
 struct ByTest<'a, 'm, 'c, K, M> {
     scene: &'a PreparedScene,
     method: WideMethod,
@@ -46,26 +46,26 @@ impl<K: Key, M: WideKeyedMemory<4>> WithTest for ByTest<'_, '_, '_, K, M> {
     type Output = Result<Counters, Error>;
     fn with<T: TriangleTest>(self) -> Self::Output {
         let ByTest { scene, method, opts, mem, chunk, .. } = self;
-        let b = KeyedBatch::<4, K, M, T> { mem, root: scene.wide_root(method)?, query: opts.query, types: PhantomData };
+        let b = TrailBatch::<4, K, M, T> { mem, root: scene.wide_root(method)?, query: opts.query, types: PhantomData };
         record(scene, Method::Wide(method), opts.record, chunk, &Independent(&b))
     }
 }
 
-/// The keyed traversal's loop over a slice of rays.
-struct KeyedBatch<'m, const W: usize, K, M, T> {
+/// The trail walk's loop over a slice of rays.
+struct TrailBatch<'m, const W: usize, K, M, T> {
     mem: &'m M,
     root: WideRoot,
     query: Query,
     types: PhantomData<(K, T)>,
 }
 
-impl<const W: usize, K: Key, M: WideKeyedMemory<W>, T: TriangleTest> RayLoop for KeyedBatch<'_, W, K, M, T> {
+impl<const W: usize, K: Key, M: WideKeyedMemory<W>, T: TriangleTest> RayLoop for TrailBatch<'_, W, K, M, T> {
     fn trace<O: Observer>(&self, rays: &[Ray], hits: &mut [Hit], obs: &mut O) {
         let (mem, root, query) = (self.mem, self.root, self.query);
         #[cfg(target_arch = "x86_64")]
         if crate::x86::available() {
             // SAFETY: the processor has AVX2 (checked just above).
-            unsafe { crate::x86::single_ray::trace_keyed_batch::<W, K, M, T, O>(mem, root, rays, hits, query, obs) };
+            unsafe { crate::x86::single_ray::trace_trail_batch::<W, K, M, T, O>(mem, root, rays, hits, query, obs) };
             return;
         }
         trace_wide_trail_batch::<W, K, M, T, FastKernel, O>(mem, root, rays, hits, query, obs);

@@ -9,6 +9,7 @@ use crate::chunk::Chunk;
 use crate::record::{record, with_test, Independent, RayLoop, Shared, SharedWalks, WithTest};
 use core::marker::PhantomData;
 use raytrail_core::intersect::TriangleTest;
+use raytrail_core::method::WideWalk;
 use raytrail_core::method::{Method, Query, WideMethod};
 use raytrail_core::observe::{Counters, Observer};
 use raytrail_core::prepared::PreparedScene;
@@ -27,8 +28,8 @@ pub(crate) fn trace_chunk(
     opts: &TraceOptions,
     chunk: Chunk<'_>,
 ) -> Result<Counters, Error> {
-    if method.keyed() {
-        return crate::keyed::trace_chunk(scene, method, opts, chunk);
+    if method.walk() == WideWalk::Trail {
+        return crate::trail::trace_chunk(scene, method, opts, chunk);
     }
     let root = scene.wide_root(method)?;
     match scene.wide_tree(method)? {
@@ -48,7 +49,7 @@ impl WideRun<'_> {
     /// Prefetches hit children where that pays ([`worth_prefetching`]).
     fn go<const W: usize>(&self, mem: WideSliceMemory<'_, W>, chunk: Chunk<'_>) -> Result<Counters, Error> {
         let bytes = core::mem::size_of_val(mem.nodes) + core::mem::size_of_val(mem.blocks);
-        if worth_prefetching(bytes, chunk.rays, self.opts.query, self.method.shares_walks()) {
+        if worth_prefetching(bytes, chunk.rays, self.opts.query, self.method.walk().shares_walks()) {
             self.test(&PrefetchingMemory(mem), chunk)
         } else {
             self.test(&mem, chunk)
@@ -73,8 +74,14 @@ impl<const W: usize, M: WideMemory<W>> WithTest for ByTest<'_, '_, '_, W, M> {
         let ByTest { run, mem, chunk } = self;
         let (root, query, method) = (run.root, run.opts.query, run.method);
         let (scene, record_what) = (run.scene, run.opts.record);
-        if method.shares_walks() {
-            let walks = SharedWalk::<W, M, T> { mem, root, query, streams: method.streams(), test: PhantomData };
+        if method.walk().shares_walks() {
+            let walks = SharedWalk::<W, M, T> {
+                mem,
+                root,
+                query,
+                streams: method.walk() == WideWalk::RayLists,
+                test: PhantomData,
+            };
             return record(scene, Method::Wide(method), record_what, chunk, &Shared(&walks));
         }
         let stack = StackBatch::<W, M, T> { mem, root, query, test: PhantomData };

@@ -11,6 +11,7 @@ use crate::stream::shared_parts::{stream_header, INTERSECT_OWN, STREAM_COMMON};
 use raytrail_core::intersect::{FAR_PAD, REFINE_SCALE, RELIABLE_LIMIT, SLACK_SCALE};
 use raytrail_core::kd::traverse::{PACKET_WIDTH, SHORT_STACK_MAX};
 use raytrail_core::key::KeyWidth;
+use raytrail_core::method::WideWalk;
 use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query, WideMethod};
 use raytrail_core::trace::{Record, TriangleTestKind};
 use raytrail_core::Error;
@@ -122,7 +123,7 @@ impl Variant {
         }
         // The wide packet and stream kernels have their own entry points (a packet or a stream to
         // a workgroup).
-        if self.method.wide().is_some_and(|m| m.shares_walks()) {
+        if self.method.wide().is_some_and(|m| m.walk().shares_walks()) {
             return Ok(parts);
         }
         // The kd packet kernel defines its own work items (one packet each).
@@ -159,14 +160,14 @@ impl Variant {
             }
             Method::Kd(KdMethod::Packet) => &[KD_COMMON, KD_PACKET],
             // The single-ray loop too: a packet hands thin subtrees to its rays.
-            Method::Wide(m) if m.packets() => &[WIDE, WIDE_STACK, WIDE_PACKET],
-            Method::Wide(m) if m.streams() => &[WIDE, WIDE_RAY_STREAM],
-            Method::Wide(m) if m.keyed() => &[WIDE, keys, HASH, WIDE_TRAIL],
+            Method::Wide(m) if m.walk() == WideWalk::Packet => &[WIDE, WIDE_STACK, WIDE_PACKET],
+            Method::Wide(m) if m.walk() == WideWalk::RayLists => &[WIDE, WIDE_RAY_STREAM],
+            Method::Wide(m) if m.walk() == WideWalk::Trail => &[WIDE, keys, HASH, WIDE_TRAIL],
             Method::Wide(_) => &[WIDE, WIDE_STACK],
             // Its stages are kernels of their own (crate::stream); this is the one that traces:
             // the 8-wide tree's files without work items or dispatch, then the stream's own.
             Method::Stream(_) => {
-                let mut parts = Variant { method: Method::Wide(WideMethod::Bvh8), ..*self }.method_parts()?;
+                let mut parts = Variant { method: Method::Wide(WideMethod::BVH8), ..*self }.method_parts()?;
                 parts.push(STREAM_COMMON);
                 parts.extend_from_slice(&INTERSECT_OWN);
                 return Ok(parts);

@@ -3,6 +3,7 @@
 
 use crate::device::device_error;
 use raytrail_core::method::Method;
+use raytrail_core::method::WideWalk;
 use raytrail_core::Error;
 
 /// How a kernel's invocations get their work items (rays, or packets of rays).
@@ -38,7 +39,7 @@ impl Dispatch {
     pub fn for_method(self, method: Method) -> Dispatch {
         match self {
             Dispatch::ByMethod => match method.wide() {
-                Some(m) if !m.keyed() && !m.shares_walks() => Dispatch::PERSISTENT,
+                Some(m) if m.walk() == WideWalk::Stack => Dispatch::PERSISTENT,
                 _ => Dispatch::Grid,
             },
             concrete => concrete,
@@ -172,7 +173,7 @@ mod tests {
         for m in Method::ALL {
             let stack = matches!(
                 m,
-                Method::Wide(WideMethod::Bvh4 | WideMethod::Bvh8 | WideMethod::Bvh4Naive | WideMethod::Bvh8Sah)
+                Method::Wide(WideMethod::BVH4 | WideMethod::BVH8 | WideMethod::BVH4_NAIVE | WideMethod::BVH8_SAH)
             );
             let want = if stack { Dispatch::PERSISTENT } else { Dispatch::Grid };
             assert_eq!(Dispatch::ByMethod.for_method(m), want, "{m}");

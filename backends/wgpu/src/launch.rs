@@ -12,6 +12,7 @@ use raytrail_core::bvh2::NodeRef;
 use raytrail_core::kd::traverse::packets::{packet_slots_of, PADDING};
 use raytrail_core::kd::traverse::PACKET_WIDTH;
 use raytrail_core::key::KeyWidth;
+use raytrail_core::method::WideWalk;
 use raytrail_core::method::{KdMethod, Method};
 use raytrail_core::trace::{Record, TraceOptions};
 use raytrail_core::wide::packet::WIDE_PACKET;
@@ -33,11 +34,11 @@ pub(crate) fn variant(scene: &WgpuScene, options: &TraceOptions, config: &GpuCon
     }
 }
 
-/// The key width of `method`'s kernel: the 4-wide tree's for the keyed wide method, the binary
+/// The key width of `method`'s kernel: the 4-wide tree's for the trail walk, the binary
 /// tree's otherwise (only the BVH2 stackless methods read it there).
 fn keys_for(scene: &WgpuScene, method: Method) -> KeyWidth {
     match method.wide() {
-        Some(m) if m.keyed() => scene.prepared.wide_keyed(m).map_or(KeyWidth::W64, |(_, keys)| keys),
+        Some(m) if m.walk() == WideWalk::Trail => scene.prepared.wide_keyed(m).map_or(KeyWidth::W64, |(_, keys)| keys),
         _ => scene.prepared.key_width(),
     }
 }
@@ -55,16 +56,16 @@ fn for_method(method: Method, config: GpuConfig) -> GpuConfig {
 }
 
 fn is_wide_packet(method: Method) -> bool {
-    method.wide().is_some_and(|m| m.packets())
+    method.wide().is_some_and(|m| m.walk() == WideWalk::Packet)
 }
 
 fn is_wide_stream(method: Method) -> bool {
-    method.wide().is_some_and(|m| m.streams())
+    method.wide().is_some_and(|m| m.walk() == WideWalk::RayLists)
 }
 
 /// Whether `method`'s kernel takes a packet or a stream of rays to a workgroup.
 fn shares_walks(method: Method) -> bool {
-    method.wide().is_some_and(|m| m.shares_walks())
+    method.wide().is_some_and(|m| m.walk().shares_walks())
 }
 
 /// The stream kernel's scratch per stream (shaders/wide_ray_stream.wgsl, `WS_REGION`): a set of
@@ -137,7 +138,7 @@ pub(crate) fn launch<'a>(
                 WideChild::Node(n) => (n, 0),
                 WideChild::Leaf { first, count } => (NodeRef::leaf(first).0, count),
             };
-            let hash = if m.keyed() {
+            let hash = if m.walk() == WideWalk::Trail {
                 // Fails with the scene's reason where it holds no tables (a tree too deep).
                 p.wide_keyed(m)?;
                 let missing = Error::NotPrepared { method: m.name(), missing: "its key hash" };

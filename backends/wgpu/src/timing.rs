@@ -11,6 +11,7 @@ use crate::scene::WgpuScene;
 use crate::workspace::bytes_moved;
 use crate::workspace::{SlotNeeds, Workspace};
 use raytrail_core::method::Method;
+use raytrail_core::method::WideWalk;
 use raytrail_core::trace::{Record, Trace, TraceOptions};
 use raytrail_core::{Error, Hit, Ray};
 use std::time::{Duration, Instant};
@@ -85,7 +86,7 @@ impl WgpuBackend {
     /// Times the kernel of `options` over `rays` at steady clocks (see the module's text);
     /// [`Error::Device`] where the adapter has no timestamp queries. The stream method is timed
     /// by whole traces (its stages' timestamps), since its passes depend on each other's sizes;
-    /// so is `bvh8-stream`, whose streams may take rounds the host waits for.
+    /// so is `bvh8-lists`, whose streams may take rounds the host waits for.
     /// Records nothing: `options.record` is ignored.
     pub fn time_kernel(
         &self,
@@ -104,7 +105,9 @@ impl WgpuBackend {
             return Err(Error::InvalidParameter { name: "rays", why: "timing needs at least one ray" });
         }
         let options = options.record(Record::Nothing);
-        if matches!(options.method, Method::Stream(_)) || options.method.wide().is_some_and(|m| m.streams()) {
+        if matches!(options.method, Method::Stream(_))
+            || options.method.wide().is_some_and(|m| m.walk() == WideWalk::RayLists)
+        {
             return self.time_whole_traces(scene, rays, &options, plan);
         }
         let pipeline = self.pipelines.get(&self.gpu, &launch::variant(scene, &options, &self.config))?;

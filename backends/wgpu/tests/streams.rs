@@ -51,7 +51,7 @@ fn trace(backend: &WgpuBackend, scene: &WgpuScene, rays: &[Ray], options: &Trace
 fn tracing_again_reuses_the_scenes_buffers() {
     let Some(backend) = open() else { return };
     let (scene, rays) = scene_and_rays(&backend, &generated_scene("sphereflake"));
-    for method in [Method::Bvh2(Bvh2Method::Hash), Method::Wide(WideMethod::Bvh8)] {
+    for method in [Method::Bvh2(Bvh2Method::Hash), Method::Wide(WideMethod::BVH8)] {
         let options = TraceOptions::new(method).record(Record::Counters);
         trace(&backend, &scene, &rays, &options);
         let after_first = scene.buffers_created();
@@ -117,7 +117,7 @@ fn settings_outside_the_adapters_limits_are_refused() {
 fn kernel_timing_and_transfer_figures() {
     let Some(backend) = open() else { return };
     let (scene, rays) = scene_and_rays(&backend, &generated_scene("sphereflake"));
-    let options = TraceOptions::new(WideMethod::Bvh4);
+    let options = TraceOptions::new(WideMethod::BVH4);
     let report = backend.trace(&scene, &rays, &options, &mut vec![Hit::MISS; rays.len()]).expect("trace");
     assert_eq!(report.transfer_bytes, rays.len() as u64 * 48, "rays up, hits down");
     assert!(report.seconds > 0.0);
@@ -127,7 +127,7 @@ fn kernel_timing_and_transfer_figures() {
     }
     assert!(report.kernel_seconds.is_some_and(|k| k > 0.0 && k <= report.seconds));
     let plan = TimingPlan { warm_up: Duration::from_millis(50), samples: 3, sample_length: Duration::from_millis(20) };
-    for method in [Method::Wide(WideMethod::Bvh4), Method::Stream(StreamMethod::Frustum8)] {
+    for method in [Method::Wide(WideMethod::BVH4), Method::Stream(StreamMethod::Frustum8)] {
         for config in [GpuConfig::default(), GpuConfig { dispatch: Dispatch::PERSISTENT, ..GpuConfig::default() }] {
             let b = backend.configured(config).expect("configured");
             let t = b.time_kernel(&scene, &rays, &TraceOptions::new(method), &plan).expect("timing");

@@ -16,7 +16,7 @@ pub use bvh2::Bvh2Method;
 pub use kd::KdMethod;
 pub use query::Query;
 pub use stream::StreamMethod;
-pub use wide::{Collapse, WideMethod, WideTreeKind};
+pub use wide::{Collapse, WideMethod, WideTreeKind, WideWalk};
 
 use crate::Error;
 use core::fmt;
@@ -75,7 +75,7 @@ impl Method {
 
     /// The wide-BVH methods, as [`Method`]s.
     pub const WIDE: [Method; WideMethod::ALL.len()] = {
-        let mut out = [Method::Wide(WideMethod::Bvh4); WideMethod::ALL.len()];
+        let mut out = [Method::Wide(WideMethod::BVH4); WideMethod::ALL.len()];
         let mut i = 0;
         while i < out.len() {
             out[i] = Method::Wide(WideMethod::ALL[i]);
@@ -128,23 +128,24 @@ impl Method {
         }
     }
 
-    /// The method of a command-line name.
+    /// The method of a command-line name, or of a former one that is still accepted
+    /// ([`WideMethod::OLD_NAMES`]).
     pub fn from_name(name: &str) -> Option<Method> {
-        Self::ALL.into_iter().find(|m| m.name() == name)
+        Self::ALL.into_iter().find(|m| m.name() == name).or_else(|| WideMethod::from_name(name).map(Method::Wide))
     }
 
     /// The method whose node enumeration this one must equal, closest hit and any hit alike
     /// (for kd methods the enumeration is the sequence of leaves: restarts revisit inner nodes).
     /// A wide method is its own reference: each tree is its own, and its enumeration is checked
     /// against the scalar reference traversal of the same tree (the serial backend's) instead;
-    /// but the keyed, stackless `bvh4-hash` must equal the stack traversal `bvh4` of its tree.
+    /// but the stackless trail walk `bvh4-hash` must equal the stack traversal `bvh4` of its tree.
     /// So is a stream method, whose enumeration is its packets' leaf lists.
     pub fn reference(self) -> Method {
         match self {
             Method::Bvh2(m) => Method::Bvh2(m.reference()),
             Method::Kd(_) => Method::Kd(KdMethod::Stack),
-            // The keyed wide method visits its stack twin's nodes, in its order.
-            Method::Wide(WideMethod::Bvh4Hash) => Method::Wide(WideMethod::Bvh4),
+            // The trail walk visits its stack twin's nodes, in its order.
+            Method::Wide(WideMethod::BVH4_HASH) => Method::Wide(WideMethod::BVH4),
             Method::Wide(m) => Method::Wide(m),
             Method::Stream(m) => Method::Stream(m),
         }
@@ -288,6 +289,32 @@ mod tests {
             Method::ALL.len()
         );
         assert_eq!((Method::ALL[0], Method::ALL[7]), (Method::Bvh2(Bvh2Method::Stack), Method::Kd(KdMethod::Stack)));
+    }
+
+    #[test]
+    fn the_ray_list_walks_former_names_still_name_them() {
+        assert_eq!(Method::from_name("bvh8-stream"), Some(Method::Wide(WideMethod::BVH8_LISTS)));
+        assert_eq!(Method::from_name("bvh8-sah-stream"), Some(Method::Wide(WideMethod::BVH8_SAH_LISTS)));
+        // The current names are the lists', and "stream" alone is still Garanzha & Loop's.
+        assert_eq!(WideMethod::BVH8_LISTS.name(), "bvh8-lists");
+        assert_eq!(Method::from_name("stream"), Some(Method::Stream(StreamMethod::Frustum8)));
+    }
+
+    #[test]
+    fn a_wide_method_is_a_tree_and_a_walk_of_those_that_exist() {
+        for (i, m) in WideMethod::ALL.into_iter().enumerate() {
+            assert_eq!(WideMethod::new(m.tree(), m.walk()), Ok(m));
+            // Methods order as the list does.
+            assert!(WideMethod::ALL[..i].iter().all(|&earlier| earlier < m), "{m}");
+        }
+        for (tree, walk) in [
+            (WideTreeKind::Four, WideWalk::Packet),
+            (WideTreeKind::FourNaive, WideWalk::Trail),
+            (WideTreeKind::Eight, WideWalk::Trail),
+            (WideTreeKind::EightSah, WideWalk::Trail),
+        ] {
+            assert!(matches!(WideMethod::new(tree, walk), Err(Error::Unsupported { .. })), "{tree:?} {walk:?}");
+        }
     }
 
     #[test]

@@ -16,6 +16,7 @@ use crate::hash::{keys_to_hash, HashCoverage, HashShape, HashStats, PerfectHash}
 use crate::kd::traverse::KdRoot;
 use crate::kd::{KdBuilder, KdSliceMemory, KdTree};
 use crate::key::KeyWidth;
+use crate::method::WideWalk;
 use crate::method::{Bvh2Method, Method, StreamMethod, WideMethod, WideTreeKind};
 use crate::scene::Scene;
 use crate::stream::{LevelBvh, StreamScene};
@@ -94,18 +95,18 @@ pub struct PreparedScene {
     pub full_hash: Option<BuiltHash>,
     /// The kd-tree (kd methods), built with [`KdBuilder::default`].
     pub kd: Option<PreparedKd>,
-    /// The 4-wide tree by Guthe's pull-up ([`WideMethod::Bvh4`]).
+    /// The 4-wide tree by Guthe's pull-up ([`WideMethod::BVH4`]).
     pub wide4: Option<WideBvh<4>>,
-    /// The hash over the 4-wide tree's node keys ([`WideMethod::Bvh4Hash`]), or why there is
+    /// The hash over the 4-wide tree's node keys ([`WideMethod::BVH4_HASH`]), or why there is
     /// none: a tree deeper than 64-bit keys allow ([`Error::TreeTooDeep`], which only that
     /// method then returns).
     pub wide4_hash: Option<Result<KeyedHash, Error>>,
-    /// The 8-wide tree by the pull-up ([`WideTreeKind::Eight`]: [`WideMethod::Bvh8`] and its
+    /// The 8-wide tree by the pull-up ([`WideTreeKind::Eight`]: [`WideMethod::BVH8`] and its
     /// packets and streams).
     pub wide8: Option<WideBvh<8>>,
-    /// The 4-wide tree with every second level removed ([`WideMethod::Bvh4Naive`]).
+    /// The 4-wide tree with every second level removed ([`WideMethod::BVH4_NAIVE`]).
     pub wide4_naive: Option<WideBvh<4>>,
-    /// The 8-wide tree by the SAH-optimal cut ([`WideTreeKind::EightSah`]: [`WideMethod::Bvh8Sah`]
+    /// The 8-wide tree by the SAH-optimal cut ([`WideTreeKind::EightSah`]: [`WideMethod::BVH8_SAH`]
     /// and its packets and streams).
     pub wide8_sah: Option<WideBvh<8>>,
     /// The 8-wide tree laid out level by level ([`StreamMethod::Frustum8`]).
@@ -200,7 +201,7 @@ impl PreparedScene {
             let bounds = bvh.nodes()[0].bounds;
             Some(match &wide8 {
                 Some(w) => LevelBvh::new(w, &bounds)?,
-                None => LevelBvh::new(&WideBvh::build(&bvh, tris, WideMethod::Bvh8.collapse())?, &bounds)?,
+                None => LevelBvh::new(&WideBvh::build(&bvh, tris, WideMethod::BVH8.collapse())?, &bounds)?,
             })
         } else {
             None
@@ -304,14 +305,14 @@ impl PreparedScene {
         })
     }
 
-    /// The memory of a keyed method ([`WideMethod::keyed`]): its 4-wide tree with the hash over
-    /// its keys, and the key width. [`Error::TreeTooDeep`] for a tree deeper than 64-bit keys
+    /// The memory of a trail-walk method ([`WideWalk::Trail`]): its 4-wide tree with the hash
+    /// over its keys, and the key width. [`Error::TreeTooDeep`] for a tree deeper than 64-bit keys
     /// allow.
     pub fn wide_keyed(
         &self,
         method: WideMethod,
     ) -> Result<(WideHashedMemory<'_, WideSliceMemory<'_, 4>>, KeyWidth), Error> {
-        let tree = self.wide4.as_ref().filter(|_| method.keyed());
+        let tree = self.wide4.as_ref().filter(|_| method.walk() == WideWalk::Trail);
         let tree = tree.ok_or(Error::NotPrepared { method: method.name(), missing: "its wide tree" })?;
         let hash =
             self.wide4_hash.as_ref().ok_or(Error::NotPrepared { method: method.name(), missing: "its key hash" })?;
@@ -348,7 +349,7 @@ impl PreparedScene {
         match method {
             Method::Bvh2(m) => self.memory(m).map(|_| ()),
             Method::Kd(_) => self.kd_memory().map(|_| ()),
-            Method::Wide(m) if m.keyed() => self.wide_keyed(m).map(|_| ()),
+            Method::Wide(m) if m.walk() == WideWalk::Trail => self.wide_keyed(m).map(|_| ()),
             Method::Wide(m) => self.wide_root(m).map(|_| ()),
             Method::Stream(m) => self.stream_scene(m).map(|_| ()),
         }

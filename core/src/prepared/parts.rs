@@ -75,7 +75,7 @@ impl Part {
             Method::Bvh2(Bvh2Method::HashResume) => &[Part::UncleLayout, Part::FullHash],
             Method::Bvh2(_) => &[Part::UncleLayout],
             Method::Kd(_) => &[Part::Kd],
-            Method::Wide(WideMethod::Bvh4Hash) => &[Part::Wide4, Part::Wide4Hash],
+            Method::Wide(WideMethod::BVH4_HASH) => &[Part::Wide4, Part::Wide4Hash],
             Method::Wide(m) => match m.tree() {
                 WideTreeKind::Four => &[Part::Wide4],
                 WideTreeKind::FourNaive => &[Part::Wide4Naive],
@@ -188,7 +188,7 @@ mod tests {
     fn retaining_drops_what_no_kept_method_reads() {
         let mut p = prepared(&Method::ALL);
         assert!(Part::ALL.iter().all(|&part| p.part_bytes(part).is_some()));
-        let keep = [Method::Wide(WideMethod::Bvh8), Method::Bvh2(Bvh2Method::Hash)];
+        let keep = [Method::Wide(WideMethod::BVH8), Method::Bvh2(Bvh2Method::Hash)];
         p.retain_parts_for(&keep);
         for part in Part::ALL {
             assert_eq!(p.part_bytes(part).is_some(), part.needed_by(&keep), "{part}");

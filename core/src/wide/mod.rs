@@ -48,7 +48,7 @@ pub use tree::{WideBvh, WideStats, WideTree};
 /// (`docs/notes/*-benchmarks-bvh8-stream.md`, "A ray-stream prototype").
 pub const STREAM_RAYS: usize = 4096;
 
-/// Rays per wide packet of [`packet`]: four registers of eight lanes on AVX2, and where packets measured best
-/// against single rays on coherent rays (the prototype's 8 to 64 rays:
+/// Rays per wide packet of [`packet`]: four registers of eight lanes on AVX2, and where packets
+/// measured best against single rays on coherent rays (the prototype's 8 to 64 rays:
 /// `docs/notes/*-benchmarks-ci-and-single-ray.md`, "Single-ray changes that did not pay").
 pub const WIDE_PACKET: usize = 32;

@@ -38,7 +38,7 @@ use crate::intersect::{RayContext, SlabRay, TriangleTest};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
 use crate::traverse::packets::{for_each_packet, GROUPING_RAYS};
-use crate::traverse::{begin_slab, Machine, QueryState};
+use crate::traverse::{begin_slab, QueryState};
 use crate::{Hit, Ray};
 use core::mem::MaybeUninit;
 
@@ -348,8 +348,7 @@ pub fn trace_wide_packet<
         let next = match child {
             _ if hand_over => {
                 each_alone::<T, O, N>(mask, &mut lanes, obs, |c, q, o| {
-                    single.restart(child);
-                    single.run(mem, c, q, o, root.max_steps)
+                    single.run_from(child, 0, mem, c, q, o, root.max_steps)
                 });
                 settle(mask, &mut lanes, &mut active);
                 pop::<N, P, O>(&stack, &mut len, &lanes.rays, active, obs)

@@ -63,32 +63,26 @@ impl<const W: usize, K: Key, C: ChildKernel> WideTrailState<W, K, C> {
     }
 }
 
-/// Where a visit leaves the walk.
-enum Visit<K> {
-    /// Go to this child, with its key and trail.
-    Next(WideChild, K, K),
-    /// The ray is done.
-    Done,
-}
-
 impl<const W: usize, K: Key, C: ChildKernel> WideTrailState<W, K, C> {
-    /// Visits `current` and finds the child after it: descends to the first child in the visiting
-    /// order, or backtracks through the register or the hash. The one transition of both
-    /// [`Machine::step`] and [`Machine::run`].
+    /// Visits `current` and moves `current`, `key` and `trail` to the child after it: descends
+    /// to the first child in the visiting order, or backtracks through the register or the hash.
+    /// Returns `false` when the ray is done (they are then left as they were). The one transition
+    /// of both [`Machine::step`] and [`Machine::run`], in place so that `run` keeps them in
+    /// registers.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn visit<M: WideKeyedMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
-        current: WideChild,
-        key: K,
-        trail: K,
+        current: &mut WideChild,
+        key: &mut K,
+        trail: &mut K,
         register: &mut Option<u32>,
         mem: &M,
         ctx: &WideRayContext<T>,
         q: &mut QueryState,
         obs: &mut O,
-    ) -> Visit<K> {
+    ) -> bool {
         obs.node(current.node_ref());
-        match current {
+        match *current {
             WideChild::Node(index) => {
                 let node = mem.wide_node(index);
                 let (lo, hi) = ctx.box_interval(q.limit());
@@ -96,24 +90,29 @@ impl<const W: usize, K: Key, C: ChildKernel> WideTrailState<W, K, C> {
                 if hits.mask != 0 {
                     let mut order = [0u32; W];
                     let n = visiting_order::<W, C>(&hits, q.any, &mut order);
-                    let Some(first) = node.child_ref(order[0] as usize) else { return Visit::Done };
+                    let Some(first) = node.child_ref(order[0] as usize) else { return false };
+                    *current = first;
+                    *key = child_key::<W, K>(*key, order[0]);
+                    *trail = trail.shl(1) | if n > 1 { K::ONE } else { K::ZERO };
                     if n > 1 {
                         *register = Some(index);
                     }
-                    let trail = trail.shl(1) | if n > 1 { K::ONE } else { K::ZERO };
-                    return Visit::Next(first, child_key::<W, K>(key, order[0]), trail);
+                    return true;
                 }
             }
             WideChild::Leaf { first, count } => {
                 leaf::<W, M, T, C, O>(mem, first, count, ctx, q, obs);
                 if q.is_answered() {
-                    return Visit::Done;
+                    return false;
                 }
             }
         }
-        match backtrack::<W, K, M, T, C, O>(mem, key, trail, register, ctx, q, obs) {
-            Some((next, k, t)) => Visit::Next(next, k, t),
-            None => Visit::Done,
+        match backtrack::<W, K, M, T, C, O>(mem, *key, *trail, register, ctx, q, obs) {
+            Some((next, k, t)) => {
+                (*current, *key, *trail) = (next, k, t);
+                true
+            }
+            None => false,
         }
     }
 }
@@ -125,16 +124,13 @@ impl<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTest, C:
     /// [`Step::AfterHit`].)
     #[inline(always)]
     fn step<O: Observer>(&mut self, mem: &M, ctx: &WideRayContext<T>, q: &mut QueryState, obs: &mut O) -> Step {
-        let Some(current) = self.current else { return Step::Done };
-        match Self::visit(current, self.key, self.trail, &mut self.register, mem, ctx, q, obs) {
-            Visit::Next(next, key, trail) => {
-                (self.current, self.key, self.trail) = (Some(next), key, trail);
-                Step::Continue
-            }
-            Visit::Done => {
-                self.current = None;
-                Step::Done
-            }
+        let Some(mut current) = self.current else { return Step::Done };
+        if Self::visit(&mut current, &mut self.key, &mut self.trail, &mut self.register, mem, ctx, q, obs) {
+            self.current = Some(current);
+            Step::Continue
+        } else {
+            self.current = None;
+            Step::Done
         }
     }
 
@@ -142,24 +138,40 @@ impl<const W: usize, K: Key, M: WideKeyedMemory<W> + ?Sized, T: TriangleTest, C:
     /// ([`WideState`](super::traverse::WideState)): `step`'s transitions in its order.
     #[inline(always)]
     fn run<O: Observer>(&mut self, mem: &M, ctx: &WideRayContext<T>, q: &mut QueryState, obs: &mut O, max_steps: u32) {
-        let Some(mut current) = self.current else { return };
-        let (mut key, mut trail, mut register, mut budget) = (self.key, self.trail, self.register, max_steps);
-        loop {
-            match Self::visit(current, key, trail, &mut register, mem, ctx, q, obs) {
-                Visit::Next(next, k, t) if budget > 0 => {
-                    (current, key, trail) = (next, k, t);
-                    budget -= 1;
-                }
-                Visit::Next(next, k, t) => {
-                    *self = Self { current: Some(next), key: k, trail: t, register, kernel: PhantomData };
-                    return;
-                }
-                Visit::Done => {
-                    *self = Self { current: None, key, trail, register, kernel: PhantomData };
-                    return;
-                }
-            }
+        if let Some(current) = self.current {
+            let (key, trail, register) = (self.key, self.trail, self.register);
+            self.run_from(current, key, trail, register, mem, ctx, q, obs, max_steps);
         }
+    }
+}
+
+impl<const W: usize, K: Key, C: ChildKernel> WideTrailState<W, K, C> {
+    /// [`Machine::run`] from `current` with its key, trail and register: the batch loop starts
+    /// each ray here, its start in registers rather than written into a state and read back (as
+    /// for the stack walk: `docs/notes/*-one-driver-one-dispatch.md`, "Checks").
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn run_from<M: WideKeyedMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
+        &mut self,
+        mut current: WideChild,
+        mut key: K,
+        mut trail: K,
+        mut register: Option<u32>,
+        mem: &M,
+        ctx: &WideRayContext<T>,
+        q: &mut QueryState,
+        obs: &mut O,
+        max_steps: u32,
+    ) {
+        let mut budget = max_steps;
+        while Self::visit(&mut current, &mut key, &mut trail, &mut register, mem, ctx, q, obs) {
+            if budget == 0 {
+                *self = Self { current: Some(current), key, trail, register, kernel: PhantomData };
+                return;
+            }
+            budget -= 1;
+        }
+        self.current = None;
     }
 }
 
@@ -256,7 +268,8 @@ pub fn trace_wide_trail_batch<
     obs: &mut O,
 ) {
     for_each_ray::<T, crate::intersect::NoPair>(rays, hits, root.scene_scale, query, |ctx, q| {
-        WideTrailState::<W, K, C>::new(root.root).run(mem, ctx, q, obs, root.max_steps);
+        let mut state = WideTrailState::<W, K, C>::new(root.root);
+        state.run_from(root.root, K::ONE, K::ZERO, None, mem, ctx, q, obs, root.max_steps);
     });
 }
 

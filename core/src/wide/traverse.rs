@@ -50,13 +50,6 @@ impl<const W: usize, K: ChildKernel> WideState<W, K> {
     pub fn new(root: WideChild) -> Self {
         Self { current: Some(root), len: 0, stack: [const { MaybeUninit::uninit() }; WIDE_STACK], kernel: PhantomData }
     }
-
-    /// Starts over at `root` for another ray, keeping the stack's storage.
-    #[inline(always)]
-    pub fn restart(&mut self, root: WideChild) {
-        self.current = Some(root);
-        self.len = 0;
-    }
 }
 
 impl<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel> Machine<M, WideRayContext<T>>
@@ -108,11 +101,13 @@ impl<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel>
 }
 
 impl<const W: usize, K: ChildKernel> WideState<W, K> {
-    /// [`Machine::run`] from `current` with `len` entries on the stack: the batch loop starts each
-    /// ray here, its start in registers rather than stored in the state and read back.
+    /// [`Machine::run`] from `current` with `len` entries on the stack, the stack's storage
+    /// reused: the batch loop and a packet's hand-over start each ray here, its start in
+    /// registers. (Written into the state by a restart and read back by `run`, it cost 7% of a
+    /// single ray's time: `docs/notes/*-one-driver-one-dispatch.md`, "Checks".)
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn run_from<M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
+    pub(crate) fn run_from<M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
         &mut self,
         mut current: WideChild,
         mut len: usize,

@@ -48,8 +48,8 @@ pub use wide::WideFlashMemory;
 /// with its stack (bvh4) and without (bvh4-hash, 16 bytes of state per ray); the 8-wide and naive
 /// 4-wide trees are not baked.
 pub const METHODS: [Method; 14] = {
-    let mut out = [Method::Wide(WideMethod::Bvh4); 14];
-    out[13] = Method::Wide(WideMethod::Bvh4Hash);
+    let mut out = [Method::Wide(WideMethod::BVH4); 14];
+    out[13] = Method::Wide(WideMethod::BVH4_HASH);
     let mut i = 0;
     while i < Method::BVH2.len() + Method::KD.len() {
         out[i] = if i < Method::BVH2.len() { Method::BVH2[i] } else { Method::KD[i - Method::BVH2.len()] };
@@ -345,10 +345,10 @@ impl FlashScene {
         Some(match method {
             Method::Bvh2(m) => trace_ray::<u32, _, Watertight, _>(m, &self.memory(m), self.root(m), ray, query, obs),
             Method::Kd(m) => trace_kd_ray::<_, Watertight, _>(m, &self.kd, &self.kd_root(), ray, query, obs),
-            Method::Wide(WideMethod::Bvh4) => {
+            Method::Wide(WideMethod::BVH4) => {
                 trace_wide_ray::<4, _, Watertight, FastKernel, _>(&self.wide, self.wide_root(), ray, query, obs)
             }
-            Method::Wide(WideMethod::Bvh4Hash) => trace_wide_trail_ray::<4, u32, _, Watertight, FastKernel, _>(
+            Method::Wide(WideMethod::BVH4_HASH) => trace_wide_trail_ray::<4, u32, _, Watertight, FastKernel, _>(
                 &self.wide_keyed_memory(),
                 self.wide_root(),
                 ray,
@@ -505,14 +505,14 @@ mod tests {
         let host = raytrail_conformance::scenes::sphereflake(baked::SPHEREFLAKE_DEPTH);
         let config = raytrail_core::bvh2::SahConfig { max_depth: 31, ..Default::default() };
         let bvh = raytrail_core::bvh2::SahBuilder::new(config).build(host.triangles()).expect("build");
-        let methods = [KdMethod::Stack.into(), WideMethod::Bvh4.into(), WideMethod::Bvh4Hash.into()];
+        let methods = [KdMethod::Stack.into(), WideMethod::BVH4.into(), WideMethod::BVH4_HASH.into()];
         let prepared = PreparedScene::new(&host, bvh, &methods).unwrap();
-        let (keyed, _) = prepared.wide_keyed(WideMethod::Bvh4Hash).unwrap();
+        let (keyed, _) = prepared.wide_keyed(WideMethod::BVH4_HASH).unwrap();
         let (kd_mem, kd_root) = (prepared.kd_memory().unwrap(), prepared.kd_root().unwrap());
-        let raytrail_core::wide::WideTree::Four(wide) = prepared.wide_tree(WideMethod::Bvh4).unwrap() else {
+        let raytrail_core::wide::WideTree::Four(wide) = prepared.wide_tree(WideMethod::BVH4).unwrap() else {
             panic!("bvh4 is four wide")
         };
-        let wide_root = prepared.wide_root(WideMethod::Bvh4).unwrap();
+        let wide_root = prepared.wide_root(WideMethod::BVH4).unwrap();
         let flash = FlashScene::load().expect("baked tables validate");
         assert_eq!((flash.kd_root(), flash.wide_root()), (kd_root, wide_root));
         for query in [Query::Closest, Query::Any] {
@@ -524,7 +524,7 @@ mod tests {
                         Method::Kd(k) => {
                             trace_kd_ray::<_, Watertight, _>(k, &kd_mem, &kd_root, &ray, query, &mut want_c)
                         }
-                        Method::Wide(WideMethod::Bvh4Hash) => {
+                        Method::Wide(WideMethod::BVH4_HASH) => {
                             trace_wide_trail_ray::<4, u32, _, Watertight, FastKernel, _>(
                                 &keyed,
                                 wide_root,

@@ -4,10 +4,9 @@
 //! Rays are grouped in warps of `W` lanes (default 32). In each cycle every lane whose traversal
 //! has not ended makes exactly one [`Machine::step`](raytrail_core::traverse::Machine::step) of the
 //! core's own state machine (the code the CPU backend runs) of any structure: the BVH2 methods, the
-//! kd methods but kd-packet, and the wide BVHs but the packet and stream methods (bvh8-packet,
-//! bvh8-stream and their `-sah` twins, whose rays share walks) and the stackless bvh4-hash (a
-//! state machine, `WideTrailState`, whose lanes would need a counting keyed memory: not yet
-//! here). The simulator records how many lanes were active, what each transition
+//! kd methods but kd-packet, and the wide BVHs but the packet and ray-list methods (bvh8-packet,
+//! bvh8-lists and their `-sah` twins, whose rays share walks), the stackless bvh4-hash included.
+//! The simulator records how many lanes were active, what each transition
 //! was (internal node, leaf, backtracking step served by a stack pop, the register, the hash, a
 //! walk over links or a restart) and what it read, through [`CountingMemory`], [`CountingKdMemory`] or
 //! [`CountingWideMemory`]. From that it reports SIMT efficiency, cycles per warp, memory traffic per
@@ -28,6 +27,7 @@ pub mod sim;
 pub mod start;
 mod stepper;
 pub mod stream_lanes;
+mod trail_lanes;
 mod wide_lanes;
 
 pub use memory::{CountingKdMemory, CountingMemory, CountingWideMemory, ReadTally, Table, Traffic};

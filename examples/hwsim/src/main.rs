@@ -29,12 +29,12 @@ USAGE:
               . idle, i internal node, l leaf; backtracks: s stack pop, r register, h hash,
               w walk over links, x restart (upper case: after a leaf)";
 
-/// The methods the simulator steps: every method but the packet ones and the keyed wide one (the
-/// stream method has a model of its own, `stream_lanes`).
+/// The methods the simulator steps: every method whose rays walk alone (the stream method has a
+/// model of its own, `stream_lanes`).
 fn simulated() -> Vec<Method> {
     Method::ALL
         .into_iter()
-        .filter(|&m| m != Method::Kd(KdMethod::Packet) && !m.wide().is_some_and(|w| w.shares_walks() || w.keyed()))
+        .filter(|&m| m != Method::Kd(KdMethod::Packet) && m.wide().is_none_or(|w| !w.walk().shares_walks()))
         .collect()
 }
 

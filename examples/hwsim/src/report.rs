@@ -3,6 +3,7 @@
 use crate::memory::{Table, LINE_BYTES};
 use crate::sim::{CycleRecord, MethodReport};
 use raytrail_core::method::WideMethod;
+use raytrail_core::method::WideWalk;
 use raytrail_core::prepared::PreparedScene;
 use std::fmt::Write as _;
 
@@ -174,7 +175,7 @@ pub fn structures(p: &PreparedScene) -> String {
         );
     }
     // The packet method walks bvh8's tree, the keyed one bvh4's.
-    for m in WideMethod::ALL.into_iter().filter(|m| !m.shares_walks() && !m.keyed()) {
+    for m in WideMethod::ALL.into_iter().filter(|m| m.walk() == WideWalk::Stack) {
         if let Ok(t) = p.wide_tree(m) {
             let st = t.stats();
             let w = m.width();

@@ -6,8 +6,10 @@ use crate::bvh2_lanes::simulate_bvh2;
 use crate::kd_lanes::simulate_kd;
 use crate::memory::Traffic;
 use crate::stepper::{Outcome, Stepper};
+use crate::trail_lanes::simulate_trail;
 use crate::wide_lanes::simulate_wide;
 use raytrail_core::bvh2::NodeRef;
+use raytrail_core::method::WideWalk;
 use raytrail_core::method::{Bvh2Method, Method, Query};
 use raytrail_core::observe::{Backtrack, Counters, Observer};
 use raytrail_core::prepared::PreparedScene;
@@ -229,9 +231,9 @@ pub struct MethodRun {
 
 /// Simulates `method` over `rays` in lockstep warps, with the watertight triangle test: any BVH2
 /// method (with the key width the tree needs), the kd methods but the packet one, and every wide
-/// method but the packet, stream and keyed ones. kd-packet and the wide packet and stream methods are
-/// lockstep units of their own (rays sharing a node) and bvh4-hash runs as one loop per ray, not a step function;
-/// they are an [`Error::Unsupported`], as is a method `prepared` lacks the tables of
+/// method whose rays walk alone (the stack walks and the stackless `bvh4-hash`). kd-packet and the
+/// wide packet and ray-list methods are lockstep units of their own (rays sharing a node): they
+/// are an [`Error::Unsupported`], as is a method `prepared` lacks the tables of
 /// ([`Error::NotPrepared`]).
 pub fn simulate(
     prepared: &PreparedScene,
@@ -243,7 +245,8 @@ pub fn simulate(
     let mut run = match method {
         Method::Bvh2(m) => simulate_bvh2(prepared, m, rays, cfg)?,
         Method::Kd(m) => simulate_kd(prepared, m, rays, cfg)?,
-        Method::Wide(m) if !m.shares_walks() && !m.keyed() => simulate_wide(prepared, m, rays, cfg)?,
+        Method::Wide(m) if m.walk() == WideWalk::Stack => simulate_wide(prepared, m, rays, cfg)?,
+        Method::Wide(m) if m.walk() == WideWalk::Trail => simulate_trail(prepared, m, rays, cfg)?,
         _ => return Err(Error::Unsupported { method: method.name(), by: "the lockstep simulator" }),
     };
     run.report.method = method;

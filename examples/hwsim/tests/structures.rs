@@ -1,15 +1,19 @@
 //! The kd-tree and wide-BVH lanes change nothing a ray computes: the simulator's hits, work
 //! counters and node enumerations equal, ray by ray, those of the core's per-ray traversals that
 //! the CPU backend runs (`trace_kd_ray`; `trace_wide_ray` with the `FastKernel`, which
-//! `trace_wide_batch` uses), for every simulated kd and wide method, every ray set and several
+//! `trace_wide_batch` uses; `trace_wide_trail_ray` for the stackless walk), for every simulated kd
+//! and wide method, every ray set and several
 //! warp widths; and the hits equal the BVH2 stack method's.
 
 use raytrail_conformance::rays::{adversarial, uniform_random, RAY_SEED};
 use raytrail_conformance::scenes::sphereflake;
 use raytrail_core::intersect::Watertight;
 use raytrail_core::kd::traverse::trace_kd_ray;
+use raytrail_core::key::KeyWidth;
+use raytrail_core::method::WideWalk;
 use raytrail_core::method::{KdMethod, Method, Query, WideMethod};
 use raytrail_core::observe::{Both, Counters, Recorder};
+use raytrail_core::wide::trail::trace_wide_trail_ray;
 use raytrail_core::wide::traverse::trace_wide_ray;
 use raytrail_core::wide::{FastKernel, WideTree};
 use raytrail_core::{Error, Hit, Ray};
@@ -25,6 +29,17 @@ fn cpu(s: &Scenario, m: Method, ray: &Ray, query: Query) -> (Hit, Both<Counters,
     let hit = match m {
         Method::Kd(k) => {
             trace_kd_ray::<_, Watertight, _>(k, &p.kd_memory().unwrap(), &p.kd_root().unwrap(), ray, query, &mut obs)
+        }
+        Method::Wide(w) if w.walk() == WideWalk::Trail => {
+            let (root, (mem, keys)) = (p.wide_root(w).unwrap(), p.wide_keyed(w).unwrap());
+            match keys {
+                KeyWidth::W32 => {
+                    trace_wide_trail_ray::<4, u32, _, Watertight, FastKernel, _>(&mem, root, ray, query, &mut obs)
+                }
+                KeyWidth::W64 => {
+                    trace_wide_trail_ray::<4, u64, _, Watertight, FastKernel, _>(&mem, root, ray, query, &mut obs)
+                }
+            }
         }
         Method::Wide(w) => {
             let root = p.wide_root(w).unwrap();
@@ -87,8 +102,18 @@ fn check_all(s: &Scenario, rays: &[Ray], query: Query, warp: usize) {
             _ => assert_eq!((r.stack_pushes, r.transitions.stack_pop, r.stack_bytes_per_ray()), (0, 0, None), "{m}"),
         }
     }
-    for m in WideMethod::ALL.into_iter().filter(|m| !m.shares_walks() && !m.keyed()).map(Method::Wide) {
+    for w in WideMethod::ALL.into_iter().filter(|m| !m.walk().shares_walks()) {
+        let m = Method::Wide(w);
         let r = check(s, m, rays, query, warp, &stack).report;
+        if w.walk() == WideWalk::Trail {
+            // No stack. A backtrack tries ancestors up the trail until one has a child left to
+            // visit, each through the register or one hash lookup (a displacement entry and at
+            // most a cell): at most two reads per level after the node's own.
+            assert_eq!((r.stack_pushes, r.transitions.stack_pop, r.stack_bytes_per_ray()), (0, 0, None), "{m}");
+            let depth = s.prepared.wide_tree(w).unwrap().stats().depth;
+            assert!(r.max_chain >= 1 && r.max_chain <= 1 + 2 * depth, "{m}: {} over depth {depth}", r.max_chain);
+            continue;
+        }
         if query == Query::Closest {
             // A closest-hit wide traversal ends with an empty stack: every entry is popped
             // (visited or culled).
@@ -144,14 +169,17 @@ fn the_papers_orderings_hold_on_the_model() {
     // block of four make it shallower than the 16 levels a per-triangle cost gave), against 16.
     assert!(hash.state_bytes * 3 < bstack.state_bytes, "{} {}", hash.state_bytes, bstack.state_bytes);
 
-    let bvh4 = run(Method::Wide(WideMethod::Bvh4));
+    let bvh4 = run(Method::Wide(WideMethod::BVH4));
     assert!(
         bvh4.dependent_reads * 3 < bstack.dependent_reads * 2,
         "{} {}",
         bvh4.dependent_reads,
         bstack.dependent_reads
     );
-    let four = s.prepared.wide_tree(WideMethod::Bvh4).unwrap().stats().nodes * 128;
+    // Binder & Keller's trail carried to the 4-wide tree: a fraction of the stack walk's state.
+    let trail = run(Method::Wide(WideMethod::BVH4_HASH));
+    assert!(trail.state_bytes * 3 < bvh4.state_bytes, "{} {}", trail.state_bytes, bvh4.state_bytes);
+    let four = s.prepared.wide_tree(WideMethod::BVH4).unwrap().stats().nodes * 128;
     assert!(four < s.prepared.uncles.as_ref().unwrap().nodes.len() * 64);
 }
 
@@ -160,11 +188,4 @@ fn kd_packet_is_refused_with_a_typed_error() {
     let s = Scenario::new(sphereflake(1), RayKind::Primary, 4, 4).unwrap();
     let got = simulate(&s.prepared, KdMethod::Packet, &s.rays, &SimConfig::new(Query::Closest));
     assert!(matches!(got.err(), Some(Error::Unsupported { method: "kd-packet", .. })));
-}
-
-#[test]
-fn the_keyed_wide_method_is_refused_with_a_typed_error() {
-    let s = Scenario::new(sphereflake(1), RayKind::Primary, 4, 4).unwrap();
-    let got = simulate(&s.prepared, WideMethod::Bvh4Hash, &s.rays, &SimConfig::new(Query::Closest));
-    assert!(matches!(got.err(), Some(Error::Unsupported { method: "bvh4-hash", .. })));
 }

@@ -2,7 +2,7 @@
 //! file per walk over one shared child kernel:
 //! - [`child_kernel`]: an 8-wide node's boxes in one 256-bit operation per plane, hit children
 //!   ordered by rank (every walk's box tests);
-//! - [`single_ray`]: the stack and the keyed (stackless) walks of one ray at a time;
+//! - [`single_ray`]: the stack and the (stackless) trail walks of one ray at a time;
 //! - [`stream`]: the Barringer-style ray-stream walk;
 //! - [`packet`] with [`packet_begin`] and [`packet_leaf`]: the wide packet walk, its lanes made
 //!   eight rays at a time and its leaves tested with the rays in the lanes; [`lanes`] holds the

@@ -1,4 +1,4 @@
-//! The single-ray walks compiled for AVX2 with [`AvxKernel`]: the stack walk and the keyed
+//! The single-ray walks compiled for AVX2 with [`AvxKernel`]: the stack walk and the trail
 //! (stackless) walk, a batch at a time.
 
 use super::child_kernel::AvxKernel;
@@ -28,13 +28,13 @@ pub(crate) unsafe fn trace_batch<const W: usize, M: WideMemory<W> + ?Sized, T: T
     trace_wide_batch::<W, M, T, AvxKernel, O>(mem, root, rays, hits, query, obs);
 }
 
-/// [`trace_wide_trail_batch`] (the keyed, stackless traversal) with [`AvxKernel`], compiled for
+/// [`trace_wide_trail_batch`] (the stackless trail walk) with [`AvxKernel`], compiled for
 /// AVX2.
 ///
 /// # Safety
 /// The processor must run the AVX2 path ([`available`]).
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
-pub(crate) unsafe fn trace_keyed_batch<
+pub(crate) unsafe fn trace_trail_batch<
     const W: usize,
     K: Key,
     M: WideKeyedMemory<W> + ?Sized,
