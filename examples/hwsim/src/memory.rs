@@ -291,6 +291,11 @@ impl<M> CountingWideMemory<M> {
     pub fn tally(&self) -> &ReadTally {
         &self.tally
     }
+
+    /// Reads of the hash tables so far (displacement and cells: the stackless walk's lookups).
+    pub fn hash_reads(&self) -> u64 {
+        self.tally.reads(Table::Displacement) + self.tally.reads(Table::HashCells)
+    }
 }
 
 impl<const W: usize, M: WideMemory<W>> WideMemory<W> for CountingWideMemory<M> {

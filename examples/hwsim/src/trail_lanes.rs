@@ -5,6 +5,7 @@
 use crate::memory::{CountingWideMemory, Table, Traffic};
 use crate::sim::{drive, LaneObserver, MethodRun, SimConfig};
 use crate::stepper::{Outcome, Stepper};
+use crate::wide_lanes::hit_children;
 use raytrail_core::hash::lookup_in;
 use raytrail_core::intersect::{NoPair, Watertight};
 use raytrail_core::key::{Key, KeyWidth};
@@ -14,7 +15,7 @@ use raytrail_core::traverse::{begin, Machine, QueryState};
 use raytrail_core::wide::keyed::{WideHashedMemory, WideKeyedMemory};
 use raytrail_core::wide::trail::WideTrailState;
 use raytrail_core::wide::traverse::{WideRayContext, WideRoot};
-use raytrail_core::wide::{ChildKernel, FastKernel, WideMemory};
+use raytrail_core::wide::{FastKernel, WideMemory};
 use raytrail_core::{Error, Ray};
 use std::marker::PhantomData;
 
@@ -71,18 +72,13 @@ impl<const W: usize, K: Key, M: WideMemory<W>> Stepper for TrailLanes<W, K, Wide
 
     fn step(&self, (state, ctx): &mut Self::Lane, q: &mut QueryState, obs: &mut LaneObserver) -> Outcome {
         let limit = q.limit();
-        let hash_reads = self.hash_reads();
+        let hash_reads = self.mem.hash_reads();
         let step = state.step(&self.mem, ctx, q, obs);
-        // Re-derive (without counting the read) whether the node left siblings to visit: the
-        // walk then writes itself into the register (no stack).
-        let postponed = obs.step.node.filter(|n| !n.is_leaf()).is_some_and(|n| {
-            let node = self.mem.inner().wide_node(n.index());
-            let (lo, hi) = ctx.box_interval(limit);
-            FastKernel::test::<W>(&node, &ctx.slab, lo, hi).mask.count_ones() > 1
-        }) as u32;
+        // A node that leaves siblings to visit writes itself into the register (no stack).
+        let postponed = u32::from(hit_children::<W, _>(self.mem.inner(), obs, ctx, limit) > 1);
         // The node (or leaf) from its parent's slot, then each hash read of a backtrack after
         // the one before: a lookup is a displacement entry and, unless it held the node, a cell.
-        let rounds = 1 + (self.hash_reads() - hash_reads) as u32;
+        let rounds = 1 + (self.mem.hash_reads() - hash_reads) as u32;
         Outcome { step, resumed: false, postponed, pushed: 0, dropped: 0, rounds }
     }
 
@@ -100,12 +96,5 @@ impl<const W: usize, K: Key, M: WideMemory<W>> Stepper for TrailLanes<W, K, Wide
 
     fn traffic(&self) -> Traffic {
         self.mem.tally().traffic()
-    }
-}
-
-impl<const W: usize, K, M> TrailLanes<W, K, M> {
-    /// Reads of the hash tables so far.
-    fn hash_reads(&self) -> u64 {
-        self.mem.tally().reads(Table::Displacement) + self.mem.tally().reads(Table::HashCells)
     }
 }

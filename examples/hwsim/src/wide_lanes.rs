@@ -29,6 +29,22 @@ pub(crate) fn simulate_wide(
     })
 }
 
+/// The children the step's internal node hit (0 after a leaf), re-derived from `mem` without
+/// counting the read, with the culling distance `limit` the step started from (an internal
+/// node's step uses it unchanged).
+pub(crate) fn hit_children<const W: usize, M: WideMemory<W>>(
+    mem: &M,
+    obs: &LaneObserver,
+    ctx: &WideRayContext<Watertight>,
+    limit: f32,
+) -> u32 {
+    obs.step.node.filter(|n| !n.is_leaf()).map_or(0, |n| {
+        let node = mem.wide_node(n.index());
+        let (lo, hi) = ctx.box_interval(limit);
+        FastKernel::test::<W>(&node, &ctx.slab, lo, hi).mask.count_ones()
+    })
+}
+
 /// Lanes of a `W`-wide tree.
 struct WideLanes<const W: usize, M> {
     mem: CountingWideMemory<M>,
@@ -54,13 +70,8 @@ impl<const W: usize, M: WideMemory<W>> Stepper for WideLanes<W, M> {
     fn step(&self, (state, ctx): &mut Self::Lane, q: &mut QueryState, obs: &mut LaneObserver) -> Outcome {
         let limit = q.limit();
         let step = state.step(&self.mem, ctx, q, obs);
-        // Re-derive (without counting the read) how many children the node postponed: every hit
-        // child but the one visited next is pushed.
-        let pushed = obs.step.node.filter(|n| !n.is_leaf()).map_or(0, |n| {
-            let node = self.mem.inner().wide_node(n.index());
-            let (lo, hi) = ctx.box_interval(limit);
-            FastKernel::test::<W>(&node, &ctx.slab, lo, hi).mask.count_ones().saturating_sub(1)
-        });
+        // Every hit child but the one visited next is pushed.
+        let pushed = hit_children::<W, _>(self.mem.inner(), obs, ctx, limit).saturating_sub(1);
         // A node's address comes from its parent, a leaf's triangles from the parent's slot, and
         // the primitive ids of a leaf's positions are known with the triangles: one round trip.
         Outcome { step, resumed: false, postponed: pushed, pushed, dropped: 0, rounds: 1 }
