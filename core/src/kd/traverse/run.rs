@@ -76,7 +76,7 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
     let ctx = KdRayContext::<T>::from_slab(ray, slab);
     let mut q = QueryState::new(ray, query);
     match method {
-        KdMethod::Stack => KdStackState::run_fresh(t0, t1, mem, &ctx, &mut q, obs, root.max_steps),
+        KdMethod::Stack => KdStackState::new(t0, t1).run(mem, &ctx, &mut q, obs, root.max_steps),
         KdMethod::Restart => {
             KdRestartState::new(t0, t1, RestartPolicy::RESTART).run(mem, &ctx, &mut q, obs, root.max_steps)
         }

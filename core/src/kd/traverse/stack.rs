@@ -61,47 +61,11 @@ impl<M: KdMemory + ?Sized, T: TriangleTest> Machine<M, KdRayContext<T>> for KdSt
     #[inline(always)]
     fn run<O: Observer>(&mut self, mem: &M, ctx: &KdRayContext<T>, q: &mut QueryState, obs: &mut O, max_steps: u32) {
         let mut c = Cursor { node: self.node, t_min: self.t_min, t_max: self.t_max, len: self.len };
-        run_cursor(&mut c, &mut self.stack, mem, ctx, q, obs, max_steps);
+        let mut budget = max_steps;
+        while advance(&mut c, &mut self.stack, mem, ctx, q, obs) != Step::Done && budget > 0 {
+            budget -= 1;
+        }
         (self.node, self.t_min, self.t_max, self.len) = (c.node, c.t_min, c.t_max, c.len);
-    }
-}
-
-impl KdStackState {
-    /// [`Machine::run`] of a fresh state over the segment `[t_min, t_max]`, with the stack a
-    /// local: the state is never built, so its 768-byte stack is not moved into place first
-    /// (which cost 3.7% of a diffuse ray's instructions: `docs/notes/*-one-driver-one-dispatch.md`,
-    /// "Checks").
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    pub fn run_fresh<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
-        t_min: f32,
-        t_max: f32,
-        mem: &M,
-        ctx: &KdRayContext<T>,
-        q: &mut QueryState,
-        obs: &mut O,
-        max_steps: u32,
-    ) {
-        let mut stack = [MaybeUninit::uninit(); CAPACITY];
-        let mut c = Cursor { node: 0, t_min, t_max, len: 0 };
-        run_cursor(&mut c, &mut stack, mem, ctx, q, obs, max_steps);
-    }
-}
-
-/// Transitions from `c` until the ray is done, or for at most `max_steps` after the first.
-#[inline(always)]
-fn run_cursor<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
-    c: &mut Cursor,
-    stack: &mut [MaybeUninit<Entry>; CAPACITY],
-    mem: &M,
-    ctx: &KdRayContext<T>,
-    q: &mut QueryState,
-    obs: &mut O,
-    max_steps: u32,
-) {
-    let mut budget = max_steps;
-    while advance(c, stack, mem, ctx, q, obs) != Step::Done && budget > 0 {
-        budget -= 1;
     }
 }
 
