@@ -61,8 +61,24 @@ struct KdWalk<'a, T> {
 
 impl<T: TriangleTest> RayLoop for KdWalk<'_, T> {
     fn trace<O: Observer>(&self, rays: &[Ray], hits: &mut [Hit], obs: &mut O) {
+        // One loop per method, the method a constant in each: the per-ray match leaves the loop,
+        // and each walk's registers are its own.
+        match self.method {
+            KdMethod::Stack => self.each(KdMethod::Stack, rays, hits, obs),
+            KdMethod::Restart => self.each(KdMethod::Restart, rays, hits, obs),
+            KdMethod::PushDown => self.each(KdMethod::PushDown, rays, hits, obs),
+            KdMethod::ShortStack => self.each(KdMethod::ShortStack, rays, hits, obs),
+            KdMethod::Packet => self.each(KdMethod::Packet, rays, hits, obs),
+        }
+    }
+}
+
+impl<T: TriangleTest> KdWalk<'_, T> {
+    /// Traces each ray alone with `method`.
+    #[inline(always)]
+    fn each<O: Observer>(&self, method: KdMethod, rays: &[Ray], hits: &mut [Hit], obs: &mut O) {
         for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
-            *hit = trace_kd_ray::<_, T, _>(self.method, &self.mem, &self.root, ray, self.query, obs);
+            *hit = trace_kd_ray::<_, T, _>(method, &self.mem, &self.root, ray, self.query, obs);
         }
     }
 }
