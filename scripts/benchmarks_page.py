@@ -27,6 +27,7 @@ PAGE = "BENCHMARKS.md"
 
 # Methods renamed since results were recorded (old name, current name): table cells show the
 # current name, commands keep the one they ran with (the CLI still parses it for one release).
+# The same pairs as WideMethod::OLD_NAMES (core/src/method/wide.rs); a core test holds them equal.
 RENAMED = [("bvh8-sah-stream", "bvh8-sah-lists"), ("bvh8-stream", "bvh8-lists")]
 
 

@@ -301,6 +301,17 @@ mod tests {
     }
 
     #[test]
+    fn the_results_page_knows_every_former_name() {
+        // scripts/benchmarks_page.py shows results recorded under a former name under the current
+        // one (its RENAMED list): each pair here must be there.
+        let script = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/benchmarks_page.py"));
+        for (old, m) in WideMethod::OLD_NAMES {
+            let pair = std::format!("(\"{old}\", \"{}\")", m.name());
+            assert!(script.contains(&pair), "scripts/benchmarks_page.py's RENAMED lacks {pair}");
+        }
+    }
+
+    #[test]
     fn a_wide_method_is_a_tree_and_a_walk_of_those_that_exist() {
         for (i, m) in WideMethod::ALL.into_iter().enumerate() {
             assert_eq!(WideMethod::new(m.tree(), m.walk()), Ok(m));
