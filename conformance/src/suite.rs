@@ -23,7 +23,7 @@ use raytrail_core::wide::WideBvh;
 use raytrail_core::{Hit, Ray};
 use std::any::Any;
 use std::fmt::Display;
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Set to 1 to make a backend whose constructor fails (no GPU adapter) fail the suite instead of
 /// skipping it (CI sets it, with a software Vulkan driver installed).
@@ -96,29 +96,46 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
     }
 }
 
-/// Runs one case on the backend `make` builds, once per test binary: a backend whose
-/// constructor fails is skipped with its reason printed, or fails when [`REQUIRE_GPU`] is 1.
+/// Runs one case on a backend `make` builds: one of those made by the binary's earlier tests if
+/// one is idle, else a new one. A backend whose constructor fails is skipped with its reason
+/// printed (from then on, for the whole binary), or fails when [`REQUIRE_GPU`] is 1.
+///
+/// A device and its compiled kernels are costly to make, so they are kept for the tests that
+/// follow; but one backend per test running at once, not one for them all: a device runs one
+/// dispatch at a time, and on a CPU adapter a dispatch of few workgroups keeps one core busy
+/// (one device for two test threads left half of a two-core machine idle).
 pub fn run_case_or_skip<B: Trace + 'static, E: Display>(make: impl FnOnce() -> Result<B, E>, case: Case) {
-    // One backend for the whole binary (a device and its compiled kernels are costly to make).
-    static BACKEND: OnceLock<Result<Box<dyn Any + Send + Sync>, String>> = OnceLock::new();
-    let made =
-        BACKEND.get_or_init(|| make().map(|b| Box::new(b) as Box<dyn Any + Send + Sync>).map_err(|e| e.to_string()));
-    match made {
-        Ok(b) => match b.downcast_ref::<B>() {
-            Some(b) => run_case(b, case),
-            None => panic!("one test binary opted into the suite with two backend types"),
+    static IDLE: Mutex<Vec<Box<dyn Any + Send + Sync>>> = Mutex::new(Vec::new());
+    static UNAVAILABLE: OnceLock<String> = OnceLock::new();
+    let idle = || IDLE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let reason = UNAVAILABLE.get();
+    let kept = if reason.is_none() { idle().pop() } else { None };
+    let backend: Box<dyn Any + Send + Sync> = match (kept, reason) {
+        (Some(b), _) => b,
+        (None, Some(reason)) => return unavailable(reason, case),
+        (None, None) => match make() {
+            Ok(b) => Box::new(b),
+            Err(e) => return unavailable(UNAVAILABLE.get_or_init(|| e.to_string()), case),
         },
-        Err(e) if std::env::var(REQUIRE_GPU).as_deref() == Ok("1") => {
-            panic!("{REQUIRE_GPU}=1 but the backend is unavailable: {e}")
-        }
-        Err(e) => {
-            static SAID: std::sync::Once = std::sync::Once::new();
-            SAID.call_once(|| {
-                eprintln!("SKIPPED the conformance suite: {e} (set {REQUIRE_GPU}=1 to make this a failure)")
-            });
-            eprintln!("SKIPPED {case:?}");
-        }
+    };
+    match backend.downcast_ref::<B>() {
+        Some(b) => run_case(b, case),
+        None => panic!("one test binary opted into the suite with two backend types"),
     }
+    // Kept only after the case passed: a backend that failed one is not trusted with the next.
+    idle().push(backend);
+}
+
+/// A case whose backend could not be made: a failure when [`REQUIRE_GPU`] is 1, else a skip.
+fn unavailable(reason: &str, case: Case) {
+    if std::env::var(REQUIRE_GPU).as_deref() == Ok("1") {
+        panic!("{REQUIRE_GPU}=1 but the backend is unavailable: {reason}")
+    }
+    static SAID: std::sync::Once = std::sync::Once::new();
+    SAID.call_once(|| {
+        eprintln!("SKIPPED the conformance suite: {reason} (set {REQUIRE_GPU}=1 to make this a failure)")
+    });
+    eprintln!("SKIPPED {case:?}");
 }
 
 /// A generated scene by name.
@@ -206,8 +223,8 @@ pub fn mismatch_report(scene: &str, backend: &str, checked: usize, mismatches: &
 
 /// Defines one `#[test]` per [`Case`] of the suite for a backend:
 /// `conformance_suite!(CpuBackend::new());`, or with `try` for a constructor returning a
-/// `Result` (the backend is then made once per test binary, and skipped if it cannot be made
-/// unless [`REQUIRE_GPU`] is 1). `small: try ...` defines only the cases that reach every kernel
+/// `Result` (a backend is then made once for each test running at once and kept for the tests
+/// after it, and skipped if it cannot be made unless [`REQUIRE_GPU`] is 1: [`run_case_or_skip`]). `small: try ...` defines only the cases that reach every kernel
 /// and both key widths without the large meshes (generated scenes, the Cornell box and the
 /// teapot), for a second configuration of a backend whose every kernel the full suite already
 /// ran on every mesh.

@@ -332,6 +332,31 @@ mod tests {
         assert_eq!(n, 2 * Method::ALL.len() * 2 * 2 * 3 * 2);
     }
 
+    /// The kernel cache (pipelines.rs) compiles once per distinct text: methods that differ only
+    /// in their tree share a kernel, and methods that walk differently never do.
+    #[test]
+    fn a_kernel_is_shared_by_the_methods_of_one_walk_only() {
+        let text_of = |method: Method| {
+            let v = Variant {
+                method,
+                keys: KeyWidth::W32,
+                triangle: TriangleTestKind::Watertight,
+                query: Query::Closest,
+                record: Record::Nothing,
+                dispatch: DispatchKind::Grid,
+                workgroup_size: 64,
+            };
+            (v.source().expect("a kernel"), v.overrides())
+        };
+        let text = |m: WideMethod| text_of(Method::Wide(m));
+        assert_eq!(text(WideMethod::BVH8), text(WideMethod::BVH8_SAH));
+        assert_eq!(text(WideMethod::BVH8_LISTS), text(WideMethod::BVH8_SAH_LISTS));
+        assert_ne!(text(WideMethod::BVH8), text(WideMethod::BVH8_PACKET));
+        assert_ne!(text(WideMethod::BVH4), text(WideMethod::BVH8));
+        let bvh2 = |m: Bvh2Method| text_of(Method::Bvh2(m));
+        assert_ne!(bvh2(Bvh2Method::Stack), bvh2(Bvh2Method::StackDisjoint));
+    }
+
     #[test]
     fn constants_are_the_cores_bits() {
         let h = constants_header(Method::Bvh2(Bvh2Method::Stack));

@@ -1,4 +1,7 @@
-//! Kernels compiled on first use and kept: one per [`Variant`] a caller asks for.
+//! Kernels compiled on first use and kept: one per [`Variant`] a caller asks for, and one per
+//! distinct kernel text. Methods that differ only in the tree they walk (`bvh8` and `bvh8-sah`,
+//! say) compose the same WGSL with the same overrides; they share one compiled kernel, since a
+//! compile is the fixed cost of a device (seconds a kernel on a CPU Vulkan driver).
 
 use crate::compose::Variant;
 use crate::device::Gpu;
@@ -11,6 +14,14 @@ pub(crate) struct Pipelines {
     pub bind_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
     compiled: Mutex<HashMap<Variant, Arc<wgpu::ComputePipeline>>>,
+    by_text: Mutex<HashMap<KernelText, Arc<wgpu::ComputePipeline>>>,
+}
+
+/// What a compiled kernel is made from: its WGSL and its override values (as bits, so they hash).
+#[derive(PartialEq, Eq, Hash)]
+struct KernelText {
+    source: String,
+    overrides: Vec<(&'static str, u64)>,
 }
 
 /// A one-group layout of buffer bindings `0..kinds.len()` (`read_only: None` is a uniform), and the
@@ -59,7 +70,7 @@ impl Pipelines {
         let (read, write) = (Some(true), Some(false));
         let (bind_layout, layout) =
             buffer_layout(gpu, "raytrail", &[None, read, write, read, read, read, write, write]);
-        Pipelines { bind_layout, layout, compiled: Mutex::new(HashMap::new()) }
+        Pipelines { bind_layout, layout, compiled: Mutex::new(HashMap::new()), by_text: Mutex::new(HashMap::new()) }
     }
 
     /// The kernel of `v`, compiled now if it was not yet.
@@ -67,9 +78,20 @@ impl Pipelines {
         if let Some(p) = self.compiled.lock().map_err(|_| poisoned())?.get(v) {
             return Ok(p.clone());
         }
-        let label = v.label();
-        let pipeline = gpu.compute_pipeline(&label, &v.source()?, &v.overrides(), &self.layout)?;
-        let pipeline = Arc::new(pipeline);
+        let overrides = v.overrides();
+        let text = KernelText {
+            source: v.source()?,
+            overrides: overrides.iter().map(|&(name, value)| (name, value.to_bits())).collect(),
+        };
+        let known = self.by_text.lock().map_err(|_| poisoned())?.get(&text).cloned();
+        let pipeline = match known {
+            Some(p) => p,
+            None => {
+                let p = Arc::new(gpu.compute_pipeline(&v.label(), &text.source, &overrides, &self.layout)?);
+                self.by_text.lock().map_err(|_| poisoned())?.insert(text, p.clone());
+                p
+            }
+        };
         self.compiled.lock().map_err(|_| poisoned())?.insert(*v, pipeline.clone());
         Ok(pipeline)
     }
