@@ -7,6 +7,7 @@ use crate::flags::{method_names_or_auto, LoadFlags, AUTO, BUILDERS, BUILTIN_SCEN
 use clap::{Parser, Subcommand};
 use raytrail::mesh::{write_sources_csv, LoadOptions, LoadReport};
 use raytrail::Builder;
+use raytrail_cli::write::same_file;
 use raytrail_conformance::NamedScene;
 use std::path::Path;
 
@@ -374,7 +375,7 @@ pub struct RenderArgs {
 pub fn ploc_note(builder: Builder, scene: &raytrail::core::scene::Scene) {
     if builder == Builder::Ploc {
         if let Some(why) = raytrail::build::ploc::ploc_fallback(scene.triangles()) {
-            eprintln!("warning: --builder ploc: {why}");
+            errln!("warning: --builder ploc: {why}");
         }
     }
 }
@@ -396,12 +397,55 @@ pub fn check_output(flag: &str, path: &str) -> Result<(), Failure> {
 }
 
 /// Checks that the input file `path` exists (`builtin` is no file): a failure (exit status 1)
-/// found before any work.
+/// found before any work, saying what the path is when it is there but no file.
 pub fn check_input(flag: &str, path: &str) -> Result<(), Failure> {
-    if path != BUILTIN_SCENE && !Path::new(path).is_file() {
-        return Err(Failure::Run(format!("--{flag}: {path}: no such file")));
+    if path == BUILTIN_SCENE {
+        return Ok(());
+    }
+    let what = match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => return Ok(()),
+        Ok(m) if m.is_dir() => "it is a folder, not a file",
+        Ok(_) => "it is a pipe or a device, not a file (the loaders read files they can seek in)",
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => "no such file",
+        Err(e) => return Err(Failure::Run(format!("--{flag}: {path}: {e}"))),
+    };
+    Err(Failure::Run(format!("--{flag}: {path}: {what}")))
+}
+
+/// Refuses, before any work, an output that is one of the command's inputs (the same file by
+/// device and inode, however it is spelled or linked: `trace --out` naming the ray file would
+/// destroy it), or the same file as another output. Devices and pipes (`/dev/null`) may be named
+/// more than once.
+pub fn check_distinct(inputs: &[(&str, &str)], outputs: &[(&str, &str)]) -> Result<(), Failure> {
+    for (i, &(flag, path)) in outputs.iter().enumerate() {
+        for &(input_flag, input) in inputs {
+            if input != BUILTIN_SCENE && same_file(path, input) {
+                return usage(format!(
+                    "--{flag} {path} is the input --{input_flag} {input}: writing it would destroy the input; name another file"
+                ));
+            }
+        }
+        for &(other_flag, other) in &outputs[i + 1..] {
+            if same_output(path, other) {
+                return usage(format!(
+                    "--{flag} and --{other_flag} name one file ({path}): one would overwrite the other"
+                ));
+            }
+        }
     }
     Ok(())
+}
+
+/// Whether two outputs name one regular file, whether or not it exists yet.
+fn same_output(a: &str, b: &str) -> bool {
+    let regular = |p: &str| std::fs::metadata(p).map_or(true, |m| m.is_file());
+    if !regular(a) || !regular(b) {
+        return false;
+    }
+    // Not there yet: the same folder (by identity) and the same name.
+    let folder = |p: &Path| p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
+    let (a, b) = (Path::new(a), Path::new(b));
+    same_file(a, b) || (a.file_name() == b.file_name() && same_file(folder(a), folder(b)))
 }
 
 /// Loads a scene (a mesh file or `builtin`) with `options`; returns the warning line to print
@@ -434,7 +478,7 @@ pub fn skipped_warning(path: &str, report: &LoadReport) -> Option<String> {
 /// Prints a warning line, if there is one, on standard error.
 pub fn warn(warning: &Option<String>) {
     if let Some(w) = warning {
-        eprintln!("{w}");
+        errln!("{w}");
     }
 }
 

@@ -36,7 +36,7 @@ pub fn prepare_for(
                     .map_err(|e| e.to_string())
             });
             let (prepared, choice) = chosen?;
-            eprintln!(
+            errln!(
                 "auto: {} (of {}; {} sample rays, {:.2} ms)",
                 choice.method,
                 choice.timed.iter().map(|t| t.method.name()).collect::<Vec<_>>().join(", "),

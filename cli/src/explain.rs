@@ -1,7 +1,7 @@
 //! `raytrail explain SCENE [--rays FILE]`: what the scene needs (the analysis of
 //! `raytrail::analysis`), as a table and optionally JSON.
 
-use crate::args::{check_input, check_output, load_scene, warn, ExplainArgs};
+use crate::args::{check_distinct, check_input, check_output, load_scene, warn, ExplainArgs};
 use crate::bench::rays::{batches, primary_rays, RayKind};
 use crate::bench::view::{Enclosure, ViewChoice};
 use crate::failure::Outcome;
@@ -33,6 +33,10 @@ pub fn main(a: ExplainArgs) -> Outcome {
     } else {
         check_image(a.width, a.height, "rays per set", "max-rays", a.max_rays, 48)?;
     }
+    let mut inputs = vec![("scene", a.scene.as_str())];
+    inputs.extend(a.rays.as_deref().map(|r| ("rays", r)));
+    let outputs: Vec<_> = a.json.as_deref().map(|j| ("json", j)).into_iter().collect();
+    check_distinct(&inputs, &outputs)?;
     let view = ViewChoice::from_name(&a.view).map_err(crate::failure::Failure::Usage)?;
     let builder = builder(&a.builder);
     let (loaded, _) = timed(&format!("loading {}", a.scene), || load_scene(&a.scene, &a.load.load_options()));
@@ -63,7 +67,7 @@ pub fn main(a: ExplainArgs) -> Outcome {
     if let Some(path) = &a.json {
         let text = serde_json::to_string_pretty(&to_json(&named.name, &analysis)).map_err(|e| e.to_string())?;
         write_atomically(path, |w| w.write_all(text.as_bytes())).map_err(|e| format!("cannot write {path}: {e}"))?;
-        eprintln!("wrote {path}");
+        errln!("wrote {path}");
     }
     Ok(0)
 }
@@ -112,7 +116,7 @@ fn yes_no(b: bool) -> &'static str {
 }
 
 fn print(name: &str, builder: &str, build_s: f64, a: &SceneAnalysis) {
-    println!(
+    outln!(
         "\nscene {name}: {} triangles; BVH2 ({builder}) built in {:.3} s, depth {}, {} keys; canonical tree {:.2} MB",
         a.triangles,
         build_s,
@@ -120,26 +124,32 @@ fn print(name: &str, builder: &str, build_s: f64, a: &SceneAnalysis) {
         a.key_width,
         mb(a.tree_bytes)
     );
-    println!("\ntables, each built alone:");
-    println!("  {:<26} {:>9} {:>10}  read by", "part", "MB", "build ms");
+    outln!("\ntables, each built alone:");
+    outln!("  {:<26} {:>9} {:>10}  read by", "part", "MB", "build ms");
     for p in &a.parts {
         let readers: Vec<&str> =
             Method::ALL.iter().filter(|m| Part::of(**m).contains(&p.part)).map(|m| m.name()).collect();
-        println!("  {:<26} {:>9.2} {:>10.1}  {}", p.part.name(), mb(p.bytes), 1e3 * p.seconds, readers.join(", "));
+        outln!("  {:<26} {:>9.2} {:>10.1}  {}", p.part.name(), mb(p.bytes), 1e3 * p.seconds, readers.join(", "));
     }
-    println!("\ntables per method (MB):");
+    outln!("\ntables per method (MB):");
     let per: Vec<String> = Method::ALL.iter().map(|&m| format!("{} {:.2}", m.name(), mb(a.method_bytes(m)))).collect();
     for line in per.chunks(6) {
-        println!("  {}", line.join(", "));
+        outln!("  {}", line.join(", "));
     }
     if !a.choices.is_empty() {
-        println!("\nmethod per ray set (candidates timed on a sample on the CPU):");
-        println!(
+        outln!("\nmethod per ray set (candidates timed on a sample on the CPU):");
+        outln!(
             "  {:<22} {:<7} {:>9} {:>7} {:<10} {:>9} {:>9}  candidates, in",
-            "rays", "query", "rays", "sample", "chosen", "choose ms", "% batch"
+            "rays",
+            "query",
+            "rays",
+            "sample",
+            "chosen",
+            "choose ms",
+            "% batch"
         );
         for c in &a.choices {
-            println!(
+            outln!(
                 "  {:<22} {:<7} {:>9} {:>7} {:<10} {:>9.2} {:>8.1}%  {}",
                 c.label,
                 c.query.name(),
@@ -153,7 +163,7 @@ fn print(name: &str, builder: &str, build_s: f64, a: &SceneAnalysis) {
         }
     }
     let n = &a.needs;
-    println!("\nwhat the chosen methods need:");
+    outln!("\nwhat the chosen methods need:");
     for (what, need) in [
         ("64-bit keys", &n.keys64),
         ("hash tables", &n.hash_tables),
@@ -161,14 +171,14 @@ fn print(name: &str, builder: &str, build_s: f64, a: &SceneAnalysis) {
         ("disjoint mask", &n.disjoint_mask),
         ("slack", &n.slack),
     ] {
-        println!("  {:<14} {:<11} {}", what, yes_no(need.needed), need.why);
+        outln!("  {:<14} {:<11} {}", what, yes_no(need.needed), need.why);
     }
     let chosen = a.chosen();
     let (chosen_bytes, chosen_s) = a.cost_of(&chosen);
     let (all_bytes, all_s) = a.cost_of(&Method::ALL);
     let variants = a.variants();
     let all_variants = raytrail::analysis::shaders::all_variant_count(a.key_width);
-    println!(
+    outln!(
         "\nwhat it saves: tables {:.2} MB for {} against {:.2} MB for every method; built in {:.0} ms against {:.0} ms; \
          {} wgpu kernels ({:.0} KB of WGSL) against {} for this key width",
         mb(chosen_bytes),
@@ -181,7 +191,7 @@ fn print(name: &str, builder: &str, build_s: f64, a: &SceneAnalysis) {
         all_variants
     );
     for v in &variants {
-        println!("  kernel {}", v.label());
+        outln!("  kernel {}", v.label());
     }
 }
 

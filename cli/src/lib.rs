@@ -2,7 +2,9 @@
 //!
 //! - [`npy`]: NumPy ray and hit files, the command line's exchange format.
 //! - [`write`](mod@write): writes that never lose a file (a temporary file renamed into place).
+//! - [`output`]: printing to stdout and stderr that never panics.
 #![warn(missing_docs)]
 
 pub mod npy;
+pub mod output;
 pub mod write;

@@ -2,6 +2,10 @@
 //! `accuracy`, `explain` and `stress`. Flags are declared with clap in [`args`]; usage errors exit with status
 //! 2, failures while working with status 1.
 
+// `outln!`, `out!`, `errln!` and `err!` (raytrail_cli::output): printing that never panics.
+#[macro_use]
+extern crate raytrail_cli;
+
 mod accuracy;
 mod args;
 mod auto;
@@ -20,13 +24,24 @@ mod svg;
 mod trace;
 
 use args::{Cli, Command};
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 
 fn main() {
     restore_sigpipe();
     let raw: Vec<String> = std::env::args_os().map(|a| a.to_string_lossy().into_owned()).collect();
-    // Usage errors exit with status 2; `--help` and `--version` print and exit with 0.
-    let cli = Cli::parse();
+    // Usage errors exit with status 2; `--help` and `--version` print and exit with 0, or with 1
+    // and one line when stdout cannot take them.
+    let cli = match parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            if let Err(io) = e.print() {
+                raytrail_cli::output::stdout_failed(&io);
+            }
+            raytrail_cli::output::flush_stdout();
+            std::process::exit(0)
+        }
+        Err(e) => e.exit(),
+    };
     let result = match cli.command {
         None => run::main(cli.run),
         Some(Command::Run(a)) => run::main(a),
@@ -39,20 +54,34 @@ fn main() {
         Some(Command::Explain(a)) => explain::main(a),
         Some(Command::Stress(a)) => stress::main(a),
     };
+    raytrail_cli::output::flush_stdout();
     match result {
         Ok(0) => {}
         Ok(code) => std::process::exit(code),
         Err(e) => {
-            eprintln!("error: {}", e.message());
+            errln!("error: {}", e.message());
             std::process::exit(e.code());
         }
     }
 }
 
+/// The arguments, with a negative number after any flag read as its value, so that
+/// `--max-mesh-bytes -5` is an error naming the flag rather than "unexpected argument '-5'".
+fn parse() -> Result<Cli, clap::Error> {
+    let negatives = |c: clap::Command| {
+        c.mut_args(|a| {
+            let takes_values = a.get_action().takes_values();
+            a.allow_negative_numbers(takes_values)
+        })
+    };
+    let command = negatives(Cli::command()).mut_subcommands(negatives);
+    Cli::from_arg_matches(&command.try_get_matches()?)
+}
+
 /// Signal dispositions of a command-line tool.
 ///
 /// Rust ignores SIGPIPE, so that printing to a closed pipe (`raytrail --help | head -3`) is an
-/// error, and `println!` panics on it. A command-line tool should do what the others do: end
+/// error, and `outln!` panics on it. A command-line tool should do what the others do: end
 /// quietly. Restoring the default action makes the process end on the signal.
 ///
 /// SIGXFSZ (a write beyond the file size limit, `ulimit -f`) would kill the process in the middle

@@ -38,7 +38,7 @@ impl Progress {
         }
         let width = 30;
         let filled = (width * self.done).checked_div(self.total).unwrap_or(width).min(width);
-        eprint!(
+        err!(
             "\r\x1b[2K{} [{}{}] {}/{} {:.1}s {}",
             self.label,
             "#".repeat(filled),
@@ -54,17 +54,17 @@ impl Progress {
     /// Clears the line.
     pub fn finish(self) {
         if self.tty {
-            eprint!("\r\x1b[2K");
+            err!("\r\x1b[2K");
         }
     }
 }
 
 /// Runs `f`, printing `what` and the time it took on standard error.
 pub fn timed<T>(what: &str, f: impl FnOnce() -> T) -> (T, f64) {
-    eprint!("{what} ... ");
+    err!("{what} ... ");
     let start = Instant::now();
     let out = f();
     let s = start.elapsed().as_secs_f64();
-    eprintln!("{:.3} s", s);
+    errln!("{:.3} s", s);
     (out, s)
 }

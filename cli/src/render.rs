@@ -3,7 +3,7 @@
 //! triangles' normals, ambient occlusion, or a heat map of the traversal work per pixel (nodes
 //! visited by `--method`, from its per-ray node enumeration), so methods can be compared by eye.
 
-use crate::args::{check_input, check_output, load_scene, warn, RenderArgs};
+use crate::args::{check_distinct, check_input, check_output, load_scene, warn, RenderArgs};
 use crate::bench::rays::{facing_normal, AoShape};
 use crate::bench::view::View;
 use crate::failure::Outcome;
@@ -37,6 +37,7 @@ pub fn main(a: RenderArgs) -> Outcome {
     let per_pixel = (std::mem::size_of::<Ray>() + std::mem::size_of::<Hit>() + 3) as u64;
     let pixels = check_image(width, height, "pixels", "max-pixels", a.max_pixels, per_pixel)? as usize;
     check_input("scene", &a.scene)?;
+    check_distinct(&[("scene", &a.scene)], &[("out", &a.out)])?;
     let method = method_or_auto(&a.method);
     let heat = a.mode == "heat" || a.mode == "backtracks";
     if heat && a.backend == "gpu" {
@@ -76,7 +77,7 @@ pub fn main(a: RenderArgs) -> Outcome {
         let counts = counts?;
         let (lo, hi) = (counts.iter().copied().min().unwrap_or(0), counts.iter().copied().max().unwrap_or(0));
         let mean = counts.iter().map(|&c| c as f64).sum::<f64>() / counts.len().max(1) as f64;
-        println!("{what} per pixel ({method}): min {lo}, mean {mean:.2}, max {hi} (colour scale: log, 0 to {hi})");
+        outln!("{what} per pixel ({method}): min {lo}, mean {mean:.2}, max {hi} (colour scale: log, 0 to {hi})");
         heat_image(&counts, hi)?
     } else {
         let gpu;
@@ -103,9 +104,12 @@ pub fn main(a: RenderArgs) -> Outcome {
         }
     };
     write_png(&a.out, width, height, &image)?;
-    println!(
+    outln!(
         "{width} x {height} {} image of {} ({method}, {} camera) written to {}",
-        a.mode, named.name, a.camera, a.out
+        a.mode,
+        named.name,
+        a.camera,
+        a.out
     );
     Ok(0)
 }

@@ -78,8 +78,8 @@ pub fn main(a: RunArgs) -> Outcome {
     let cpu = backend.prepare(prepared.clone()).map_err(|e| e.to_string())?;
     let gpu = if a.no_gpu { Err("--no-gpu".to_string()) } else { crate::gpu::Gpu::open(prepared.clone()) };
     match &gpu {
-        Ok(g) => println!("  GPU: {}", g.describe()),
-        Err(why) => println!("  GPU: skipped ({why}); the CPU figures follow"),
+        Ok(g) => outln!("  GPU: {}", g.describe()),
+        Err(why) => outln!("  GPU: skipped ({why}); the CPU figures follow"),
     }
     let gpu = gpu.ok();
     let sets = ray_sets(&backend, &cpu, scene, width, height)?;
@@ -149,22 +149,22 @@ pub fn main(a: RunArgs) -> Outcome {
         .map(|t| format!("{} {} of {}", t.refused, t.set.name, t.set.rays.len()))
         .collect();
     if !refused.is_empty() {
-        println!(
+        outln!(
             "\nREFUSED rays (outside the supported numeric range, docs/NUMERICS-RANGE.md; answered as refused, never as misses): {}",
             refused.join(", ")
         );
     }
     if failures.is_empty() {
-        println!(
+        outln!(
             "\nconformance: every method matches its reference on every checked ray (hits and node enumerations){}{}.",
             if gpu.is_some() { ", on the GPU as on the CPU, and the GPU matches the CPU ray by ray" } else { "" },
             if refused.is_empty() { "" } else { "; refused rays are left out of that: see above" }
         );
         Ok(0)
     } else {
-        println!("\nCONFORMANCE FAILED: {} mismatches. The first ones:", failures.len());
+        outln!("\nCONFORMANCE FAILED: {} mismatches. The first ones:", failures.len());
         for m in failures.iter().take(5) {
-            println!("{m}");
+            outln!("{m}");
         }
         Ok(1)
     }
@@ -198,7 +198,7 @@ fn mb(bytes: usize) -> f64 {
 
 fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedScene) {
     let s = p.bvh.stats();
-    println!(
+    outln!(
         "\nscene {name}: {} internal nodes, {} leaves (largest {}), depth {}, {} keys (the {} path)",
         s.internal_nodes,
         s.leaves,
@@ -211,7 +211,7 @@ fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedScene) {
             "64-bit, as the depth exceeds 31"
         }
     );
-    println!(
+    outln!(
         "  BVH2 ({}) built in {:.3} s; layouts {:.1} MB (nodes and leaf triangles) in {:.1} ms",
         builder.name(),
         build_s,
@@ -221,7 +221,7 @@ fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedScene) {
     let describe = |label: &str, h: &Option<BuiltHash>, secs: f64| {
         if let Some(h) = h {
             let st = &h.stats;
-            println!(
+            outln!(
                 "  {label}: {} keys of {} nodes, D = {}, H = {}, {} direct, {:.2} MB = +{:.1}% of the BVH, built in {:.1} ms ({} batches, {} growths)",
                 st.keys, p.bvh.len(), st.d_size, st.h_size, st.direct, mb(st.bytes),
                 100.0 * st.bytes as f64 / p.bvh_bytes().max(1) as f64, 1e3 * secs, st.batches, st.growths
@@ -233,7 +233,7 @@ fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedScene) {
     let binary_node_bytes = s.internal_nodes * core::mem::size_of::<raytrail::core::bvh2::BinaryNode>();
     let wide = |label: &str, st: Option<WideStats>| {
         if let Some(w) = st {
-            println!(
+            outln!(
                 "  {label}: {} nodes ({:.0}% of the binary tree's), {} empty slots, depth {}, {:.2} MB of nodes ({:+.0}% against the binary nodes' {:.2} MB)",
                 w.nodes, 100.0 * w.nodes as f64 / s.internal_nodes.max(1) as f64, w.empty_slots, w.depth,
                 mb(w.node_bytes), 100.0 * (w.node_bytes as f64 / binary_node_bytes.max(1) as f64 - 1.0), mb(binary_node_bytes)
@@ -244,23 +244,23 @@ fn print_scene(name: &str, builder: Builder, build_s: f64, p: &PreparedScene) {
     wide("8-wide BVH (pull-up)", p.wide8.as_ref().map(|t| t.stats()));
     wide("4-wide BVH (every second level)", p.wide4_naive.as_ref().map(|t| t.stats()));
     if p.wide4.is_some() || p.wide8.is_some() || p.wide4_naive.is_some() {
-        println!("  wide trees collapsed in {:.1} ms", 1e3 * p.timings.wide);
+        outln!("  wide trees collapsed in {:.1} ms", 1e3 * p.timings.wide);
     }
     match &p.wide4_hash {
         Some(Ok(h)) => {
             let (st, nodes) = (&h.hash.stats, p.wide4.as_ref().map_or(0, |t| t.stats().node_bytes));
-            println!(
+            outln!(
                 "  hash tables (4-wide node keys, bvh4-hash): {} keys, {} keys and trails, D = {}, H = {}, {} direct, {:.2} MB = +{:.1}% of the 4-wide nodes, built in {:.1} ms",
                 st.keys, h.keys, st.d_size, st.h_size, st.direct, mb(st.bytes),
                 100.0 * st.bytes as f64 / nodes.max(1) as f64, 1e3 * p.timings.wide_hash
             );
         }
-        Some(Err(e)) => println!("  hash tables (4-wide node keys, bvh4-hash): none, {e}"),
+        Some(Err(e)) => outln!("  hash tables (4-wide node keys, bvh4-hash): none, {e}"),
         None => {}
     }
     if let Some(kd) = &p.kd {
         let k = kd.tree.stats();
-        println!(
+        outln!(
             "  kd-tree (SAH, traversal cost = intersection cost): {} inner nodes, {} leaves ({} empty, largest {}), depth {}, {:.2} references per triangle, {:.1} MB, built in {:.3} s",
             k.inner_nodes, k.leaves, k.empty_leaves, k.max_leaf_size, k.depth, k.refs_per_triangle,
             mb(kd.tree.bytes()), p.timings.kd
@@ -274,7 +274,7 @@ fn per_ray(x: u64, c: &Counters) -> f64 {
 
 fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
     let set = t.set;
-    println!(
+    outln!(
         "\n{} rays: {} ({} hit), median of timed passes; conformance on {} rays",
         set.name,
         set.rays.len(),
@@ -282,9 +282,16 @@ fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
         t.checked
     );
     let gpu_head = if t.gpu.is_some() { format!(" {:>9} {:>9}", "GPU e2e", "GPU kern") } else { String::new() };
-    println!(
+    outln!(
         "  {:<15} {:>9} {:>10}{gpu_head} {:>10} {:>12} {:>10} {:>10} {:>8}  conformance",
-        "method", "Mrays/s", "vs stack", "nodes/ray", "backtr./ray", "hash/ray", "links/ray", "state B"
+        "method",
+        "Mrays/s",
+        "vs stack",
+        "nodes/ray",
+        "backtr./ray",
+        "hash/ray",
+        "links/ray",
+        "state B"
     );
     let stack_s = t.rows.iter().find(|r| r.0 == Method::Bvh2(Bvh2Method::Stack)).map_or(0.0, |r| r.1);
     for (i, (m, secs, c)) in t.rows.iter().enumerate() {
@@ -298,7 +305,7 @@ fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
             }
             None => String::new(),
         };
-        println!(
+        outln!(
             "  {:<15} {:>9.2} {:>9.2}x{gpu_col} {:>10.1} {:>12.2} {:>10.2} {:>10.2} {:>8}  {}",
             m.name(),
             set.rays.len() as f64 / secs / 1e6,
@@ -315,7 +322,7 @@ fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
     let a = &t.auto;
     let chosen_s = t.rows.iter().find(|r| r.0 == a.method).map_or(f64::NAN, |r| r.1);
     let fastest = t.rows.iter().min_by(|x, y| x.1.total_cmp(&y.1));
-    println!(
+    outln!(
         "  auto: {} ({:.2} Mrays/s above; the fastest is {}), chosen on a {}-ray sample in {:.2} ms = {:.1}% of one trace",
         a.method,
         set.rays.len() as f64 / chosen_s / 1e6,
@@ -330,42 +337,50 @@ fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
 /// Sec. 5.1.1: push-down visits 3-22% fewer nodes than restart, short-stack 48-52% fewer again,
 /// and short-stack within 3% of an unbounded stack).
 fn print_kd(sets: &[(&str, Vec<Row>)]) {
-    println!("\nkd-tree interior nodes visited per ray, and the ratio to the kd stack traversal (restarts per ray):");
-    print!("  {:<9}", "rays");
+    outln!("\nkd-tree interior nodes visited per ray, and the ratio to the kd stack traversal (restarts per ray):");
+    out!("  {:<9}", "rays");
     for m in Method::KD {
-        print!(" {:>22}", m.name());
+        out!(" {:>22}", m.name());
     }
-    println!();
+    outln!();
     for (name, rows) in sets {
         let get = |m: Method| rows.iter().find(|r| r.0 == m).map(|r| r.2);
         let Some(base) = get(Method::Kd(KdMethod::Stack)) else { continue };
         let base_inner = per_ray(base.internal_nodes, &base);
-        print!("  {:<9}", name);
+        out!("  {:<9}", name);
         for m in Method::KD {
             let c = get(m).unwrap_or_default();
             let inner = per_ray(c.internal_nodes, &c);
-            print!(
+            out!(
                 " {:>22}",
                 format!("{:.1} ({:.2}x, {:.2})", inner, inner / base_inner.max(1e-9), per_ray(c.restarts, &c))
             );
         }
-        println!();
+        outln!();
     }
 }
 
 /// The stream method's packets, leaf lists and stages per ray set (Garanzha & Loop 2010, Table 1
 /// and Fig. 13).
 fn print_stream(tables: &[SetResult<'_>]) {
-    println!("\nstream method (Garanzha & Loop 2010): packets, frustum leaf lists and stage times (ms):");
-    println!(
+    outln!("\nstream method (Garanzha & Loop 2010): packets, frustum leaf lists and stage times (ms):");
+    outln!(
         "  {:<9} {:>8} {:>8} {:>10} {:>8} {:>7} {:>9} {:>10} {:>13}",
-        "rays", "packets", "rays/pk", "leaves/pk", "longest", "sort", "frustums", "traversal", "intersection"
+        "rays",
+        "packets",
+        "rays/pk",
+        "leaves/pk",
+        "longest",
+        "sort",
+        "frustums",
+        "traversal",
+        "intersection"
     );
     for t in tables {
         let Some(st) = &t.stream else { continue };
         let per = |x: usize| x as f64 / st.packets.max(1) as f64;
         let ms = |s: f64| format!("{:.2}", s * 1e3);
-        println!(
+        outln!(
             "  {:<9} {:>8} {:>8.1} {:>10.1} {:>8} {:>7} {:>9} {:>10} {:>13}",
             t.set.name,
             st.packets,
@@ -381,17 +396,23 @@ fn print_stream(tables: &[SetResult<'_>]) {
 }
 
 fn print_backtracking(sets: &[(&str, Vec<Row>)]) {
-    println!("\nbacktracking steps of the hash method (Binder & Keller 2016, Fig. 3), share of all steps:");
-    println!(
+    outln!("\nbacktracking steps of the hash method (Binder & Keller 2016, Fig. 3), share of all steps:");
+    outln!(
         "  {:<9} {:>10} {:>10} {:>10} {:>11} {:>10} {:>10}   levels climbed 0..6, 7+",
-        "rays", "postponed", "uncle", "g-uncle", "gg-uncle", "hash", "direct"
+        "rays",
+        "postponed",
+        "uncle",
+        "g-uncle",
+        "gg-uncle",
+        "hash",
+        "direct"
     );
     for (name, rows) in sets {
         let Some((_, _, c)) = rows.iter().find(|r| r.0 == Method::Bvh2(Bvh2Method::Hash)) else { continue };
         let total = c.backtracks.max(1) as f64;
         let pct = |x: u64| format!("{:.1}%", 100.0 * x as f64 / total);
         let levels: Vec<String> = c.levels.iter().map(|&l| format!("{:.0}", 100.0 * l as f64 / total)).collect();
-        println!(
+        outln!(
             "  {:<9} {:>10} {:>10} {:>10} {:>11} {:>10} {:>10}   {}%",
             name,
             pct(c.register[0]),
@@ -403,5 +424,5 @@ fn print_backtracking(sets: &[(&str, Vec<Row>)]) {
             levels.join(" ")
         );
     }
-    println!("  (register: postponed = stored on postponing; uncle, g-uncle, gg-uncle = loaded from links; hash: through the table; direct: from the displacement entry)");
+    outln!("  (register: postponed = stored on postponing; uncle, g-uncle, gg-uncle = loaded from links; hash: through the table; direct: from the displacement entry)");
 }

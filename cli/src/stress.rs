@@ -18,16 +18,16 @@ pub fn main(a: StressArgs) -> Outcome {
     let cases = all_cases().map_err(|e| Failure::Run(e.to_string()))?;
     let cpu = CpuBackend::new();
     let gpu = if a.no_gpu {
-        println!("GPU: skipped (--no-gpu)");
+        outln!("GPU: skipped (--no-gpu)");
         None
     } else {
         match WgpuBackend::new() {
             Ok(b) => {
-                println!("GPU: {}", b.adapter());
+                outln!("GPU: {}", b.adapter());
                 Some(b)
             }
             Err(e) => {
-                println!("GPU: skipped ({e})");
+                outln!("GPU: skipped ({e})");
                 None
             }
         }
@@ -50,14 +50,20 @@ pub fn main(a: StressArgs) -> Outcome {
 /// Prints one line per case and backend (the methods summed) and every method that disagrees;
 /// returns the exit status.
 fn print(results: &[(String, &'static str, Vec<Tally>)], cpu_name: &str) -> i32 {
-    println!(
+    outln!(
         "\n{:<44} {:<5} {:>8} {:>9} {:>8} {:>8} {:>10}",
-        "case", "on", "rays", "agree", "near", "refused", "disagree"
+        "case",
+        "on",
+        "rays",
+        "agree",
+        "near",
+        "refused",
+        "disagree"
     );
     let mut bad = Vec::new();
     for (case, backend, tallies) in results {
         let sum = |f: fn(&Tally) -> usize| tallies.iter().map(f).sum::<usize>();
-        println!(
+        outln!(
             "{case:<44} {backend:<5} {:>8} {:>9} {:>8} {:>8} {:>10}",
             sum(|t| t.rays),
             sum(Tally::agreeing),
@@ -67,14 +73,14 @@ fn print(results: &[(String, &'static str, Vec<Tally>)], cpu_name: &str) -> i32 
         );
         bad.extend(tallies.iter().filter(|t| t.disagreeing > 0).map(|t| format!("  {case} on {backend}: {t}")));
     }
-    println!("(each row sums the {} methods; {cpu_name} and wgpu trace the same rays)", Method::ALL.len());
+    outln!("(each row sums the {} methods; {cpu_name} and wgpu trace the same rays)", Method::ALL.len());
     if bad.is_empty() {
-        println!("\nstress: every ray agrees with the exact reference or is refused where the range allows it.");
+        outln!("\nstress: every ray agrees with the exact reference or is refused where the range allows it.");
         0
     } else {
-        println!("\nSTRESS FAILED: {} method and case pairs disagree with the exact reference:", bad.len());
+        outln!("\nSTRESS FAILED: {} method and case pairs disagree with the exact reference:", bad.len());
         for b in &bad {
-            println!("{b}");
+            outln!("{b}");
         }
         1
     }

@@ -1,6 +1,6 @@
 //! `raytrail trace` and `raytrail rays`: NumPy files in and out.
 
-use crate::args::{check_input, check_output, load_scene, warn, write_prim_map};
+use crate::args::{check_distinct, check_input, check_output, load_scene, warn, write_prim_map};
 use crate::args::{RaysArgs, TraceArgs};
 use crate::failure::Outcome;
 use crate::flags::{builder, method_or_auto};
@@ -28,6 +28,9 @@ pub fn main(a: TraceArgs) -> Outcome {
     }
     check_input("rays", &a.rays)?;
     check_input("scene", &a.scene)?;
+    let mut outputs = vec![("out", a.out.as_str())];
+    outputs.extend(a.prim_map.as_deref().map(|m| ("prim-map", m)));
+    check_distinct(&[("rays", &a.rays), ("scene", &a.scene)], &outputs)?;
     let rays = npy::read_rays(&a.rays).map_err(|e| e.to_string())?;
     check_count("rays", rays.len() as u64, "max-rays", a.max_rays, RAY_AND_HIT_BYTES)?;
     let scene_path = a.scene.as_str();
@@ -57,7 +60,7 @@ pub fn main(a: TraceArgs) -> Outcome {
     let out = &a.out;
     npy::write_hits(out, &hits).map_err(|e| e.to_string())?;
     let n_hit = hits.iter().filter(|h| h.is_hit()).count();
-    println!(
+    outln!(
         "{} rays, {} hits, {} refused, {:.2} Mrays/s ({method}), written to {out}",
         rays.len(),
         n_hit,
@@ -67,7 +70,7 @@ pub fn main(a: TraceArgs) -> Outcome {
     if report.refused > 0 {
         // Refused rays are not misses: they are outside the supported range (docs/NUMERICS-RANGE.md)
         // and marked in the hits file with t = NaN, prim = 0xFFFFFFFE.
-        println!("  {} rays refused: outside the supported numeric range (docs/NUMERICS-RANGE.md)", report.refused);
+        outln!("  {} rays refused: outside the supported numeric range (docs/NUMERICS-RANGE.md)", report.refused);
     }
     Ok(0)
 }
@@ -86,6 +89,7 @@ pub fn rays_main(a: RaysArgs) -> Outcome {
     // The rays, and the pixel list Morton order sorts.
     check_image(a.width, a.height, "rays", "max-rays", a.max_rays, std::mem::size_of::<Ray>() as u64 + 8)?;
     check_input("scene", &a.scene)?;
+    check_distinct(&[("scene", &a.scene)], &[("out", &a.out)])?;
     let (named, _, warning) = load_scene(&a.scene, &a.load.load_options())?;
     warn(&warning);
     let camera = Camera::framing(named.scene.bounds());
@@ -96,7 +100,7 @@ pub fn rays_main(a: RaysArgs) -> Outcome {
     };
     let out = &a.out;
     npy::write_rays(out, &rays).map_err(|e| e.to_string())?;
-    println!("{} primary rays ({} order) written to {out}", rays.len(), a.order);
+    outln!("{} primary rays ({} order) written to {out}", rays.len(), a.order);
     Ok(0)
 }
 

@@ -106,6 +106,19 @@ fn bad_input_is_an_error_not_a_panic() {
     }
 }
 
+/// A negative number is read as the value of the flag before it, so the error names that flag
+/// (clap alone reads `-5` as an unknown flag).
+#[test]
+fn a_negative_number_is_an_error_naming_its_flag() {
+    for (flag, value) in [("--max-mesh-bytes", "-5"), ("--gpu-warm-up", "-1"), ("--stream-cell", "-0.5")] {
+        let sub = if flag == "--max-mesh-bytes" { "rays" } else { "bench" };
+        let out = bin().args([sub, "--scene", "builtin", flag, value]).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}: {err}");
+        assert!(err.contains(flag) && !err.contains("unexpected argument"), "{flag} {value}: {err}");
+    }
+}
+
 /// `bench --peers embree`: with the `embree` feature, Embree is measured beside raytrail and its
 /// occlusion agrees with the stack method's; without it, a usage error says how to get it.
 #[test]

@@ -17,7 +17,7 @@ pub mod classify;
 mod plot;
 mod report;
 
-use crate::args::{check_input, check_output, AccuracyArgs};
+use crate::args::{check_distinct, check_input, check_output, AccuracyArgs};
 use crate::bench::rays::{self, RayKind};
 use crate::bench::view::{Enclosure, View};
 use crate::failure::{Failure, Outcome};
@@ -149,6 +149,12 @@ pub fn main(a: AccuracyArgs, args: &[String]) -> Outcome {
     for path in &p.scenes {
         check_input("scene", path)?;
     }
+    let inputs: Vec<_> = p.scenes.iter().map(|s| ("scene", s.as_str())).collect();
+    let outputs: Vec<_> = [("json", &a.json), ("plot", &a.plot)]
+        .into_iter()
+        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, p)))
+        .collect();
+    check_distinct(&inputs, &outputs)?;
     let pixels = u64::from(p.width) * u64::from(p.height);
     let most = pixels.saturating_mul(p.ao_rays.max(rays::SOFT_SHADOW_SAMPLES) as u64);
     crate::limits::check_count("rays", most, "max-rays", p.max_rays, 2 * std::mem::size_of::<Ray>() as u64)?;
@@ -178,12 +184,12 @@ pub fn main(a: AccuracyArgs, args: &[String]) -> Outcome {
         let text = serde_json::to_string_pretty(&report).map_err(|e| format!("cannot write {path}: {e}"))?;
         write_atomically(path, |w| w.write_all(text.as_bytes()).and_then(|_| w.write_all(b"\n")))
             .map_err(|e| format!("cannot write {path}: {e}"))?;
-        eprintln!("wrote {path}");
+        errln!("wrote {path}");
     }
     if let Some(path) = &a.plot {
         write_atomically(path, |w| w.write_all(plot::to_svg(&report).as_bytes()))
             .map_err(|e| format!("cannot write {path}: {e}"))?;
-        eprintln!("wrote {path}");
+        errln!("wrote {path}");
     }
     let defaults_wrong: usize = report
         .scenes
@@ -194,9 +200,10 @@ pub fn main(a: AccuracyArgs, args: &[String]) -> Outcome {
         .map(|r| r.tally.errors())
         .sum();
     if defaults_wrong > 0 {
-        eprintln!(
+        errln!(
             "WARNING: the default ({} with the {} test) answered {defaults_wrong} sampled rays wrongly",
-            report.default_method, report.default_test
+            report.default_method,
+            report.default_test
         );
     }
     Ok(0)
@@ -241,7 +248,7 @@ fn measure_scene(path: &str, p: &Plan) -> Result<Vec<SceneReport>, String> {
         trace(&primary, &TraceOptions::new(stack), &mut primary_hits)?;
         let enclosure = Enclosure::of(&primary, &primary_hits, scene.triangles());
         if p.auto_view && view == View::Inside && !enclosure.is_room() {
-            println!("  inside view of {}: skipped, not a room (--view inside measures it anyway)", named.name);
+            outln!("  inside view of {}: skipped, not a room (--view inside measures it anyway)", named.name);
             continue;
         }
         let batches = rays::batches(&p.kinds, scene, &primary, &primary_hits, p.ao_rays);

@@ -87,14 +87,17 @@ pub fn mark_pareto(rows: &mut [Row]) {
 
 /// Prints one scene's tables on standard output.
 pub fn print_scene(s: &SceneReport) {
-    println!("\n{} ({} triangles)", s.name, s.triangles);
+    outln!("\n{} ({} triangles)", s.name, s.triangles);
     for r in &s.rays {
-        println!(
+        outln!(
             "  {} rays ({} hit): {} traced, {} judged against the exact reference; * on the Pareto front, \
              (d) the default",
-            r.kind, r.query, r.rays, r.sampled
+            r.kind,
+            r.query,
+            r.rays,
+            r.sampled
         );
-        println!(
+        outln!(
             "    {:<16} {:<16} {:>8} {:>7} {:>5} {:>7} {:>6} {:>6} {:>6} {:>6} {:>8} {:>9} {:>8}",
             "method",
             "test",
@@ -112,7 +115,7 @@ pub fn print_scene(s: &SceneReport) {
         );
         for row in &r.rows {
             let t = &row.tally;
-            println!(
+            outln!(
                 "    {:<16} {:<16} {:>8.2} {:>7} {:>5} {:>7} {:>6} {:>6} {:>6} {:>6} {:>8.3} {:>9.2} {:>8.3} {}{}",
                 row.method,
                 row.test,

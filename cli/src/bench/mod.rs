@@ -23,7 +23,7 @@ mod target_auto;
 mod target_gpu;
 pub mod view;
 
-use crate::args::{check_input, check_output};
+use crate::args::{check_distinct, check_input, check_output};
 use crate::failure::{Failure, Outcome};
 use crate::progress::{timed, Progress};
 use options::Options;
@@ -58,6 +58,12 @@ pub fn main(a: options::BenchArgs, args: &[String]) -> Outcome {
     for path in &opts.scenes {
         check_input("scene", path)?;
     }
+    let inputs: Vec<_> = opts.scenes.iter().map(|s| ("scene", s.as_str())).collect();
+    let outputs: Vec<_> = [("json", &opts.json), ("plot", &opts.plot)]
+        .into_iter()
+        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, p)))
+        .collect();
+    check_distinct(&inputs, &outputs)?;
     let pools = opts
         .threads
         .iter()
@@ -87,12 +93,12 @@ pub fn main(a: options::BenchArgs, args: &[String]) -> Outcome {
     if let Some(path) = &opts.json {
         write_atomically(path, |w| w.write_all(json::to_json(&report).as_bytes()))
             .map_err(|e| format!("cannot write {path}: {e}"))?;
-        eprintln!("wrote {path}");
+        errln!("wrote {path}");
     }
     if let Some(path) = &opts.plot {
         write_atomically(path, |w| w.write_all(plot::to_svg(&report).as_bytes()))
             .map_err(|e| format!("cannot write {path}: {e}"))?;
-        eprintln!("wrote {path}");
+        errln!("wrote {path}");
     }
     Ok(0)
 }
@@ -198,7 +204,7 @@ fn bench_scene(
         stack.trace(largest, &primary, Query::Closest, &mut primary_hits)?;
         let enclosure = Enclosure::of(&primary, &primary_hits, scene.triangles());
         if !opts.view.keeps(view, &enclosure) {
-            println!(
+            outln!(
                 "  {} view of {}: skipped, not a room ({:.1}% of its primary rays hit, {:.1}% of those a front side; \
                  --view both measures it anyway)",
                 view.name(),
@@ -259,7 +265,7 @@ fn print_auto_choices(
             .and_then(|r| r.rows.iter().find(|row| row.target == crate::flags::AUTO && Some(row.threads) == threads))
             .map_or(f64::NAN, |row| row.median_s);
         let kind = report.map_or("?", |r| r.kind.name());
-        println!(
+        outln!(
             "  auto [{view}, {kind}, {} thr]: {} on a {}-ray sample; choosing took {:.2} ms = {:.1}% of one trace of \
              the batch; {}",
             threads.unwrap_or(0),
@@ -322,7 +328,7 @@ fn gpu_targets(opts: &Options, cpu: &CpuScene) -> Result<Targets, String> {
     let backend = match WgpuBackend::new() {
         Ok(b) => Arc::new(b),
         Err(e) => {
-            println!("  GPU: skipped ({e})");
+            outln!("  GPU: skipped ({e})");
             return Ok(Vec::new());
         }
     };
@@ -331,7 +337,7 @@ fn gpu_targets(opts: &Options, cpu: &CpuScene) -> Result<Targets, String> {
     } else {
         "no kernel time (no timestamp queries)"
     };
-    println!("  GPU: {}; passes timed end to end by the wall clock, {kernel}", backend.adapter());
+    outln!("  GPU: {}; passes timed end to end by the wall clock, {kernel}", backend.adapter());
     let scene = Arc::new(backend.prepare(cpu.0.clone()).map_err(|e| e.to_string())?);
     let mut targets: Targets = Vec::new();
     for config in &opts.gpu {

@@ -5,20 +5,14 @@ use super::report::{mb, RayReport, Row, SceneReport};
 
 /// Prints everything measured on one scene to standard output.
 pub fn print_scene(s: &SceneReport, baseline: &str, passes: usize) {
-    println!(
-        "\n== {}: {} triangles; {} x {} primary rays ==",
-        s.name,
-        thousands(s.triangles as u64),
-        s.width,
-        s.height
-    );
-    println!("builds and memory:");
+    outln!("\n== {}: {} triangles; {} x {} primary rays ==", s.name, thousands(s.triangles as u64), s.width, s.height);
+    outln!("builds and memory:");
     for b in &s.builds {
         let bytes: Vec<String> = b.bytes.iter().map(|(what, n)| format!("{what} {:.1} MB", mb(*n))).collect();
         let total: usize = b.bytes.iter().map(|(_, n)| n).sum();
         let total = if b.bytes.len() > 1 { format!(" = {:.1} MB", mb(total)) } else { String::new() };
         let line = format!("  {:<46} {:>8.3} s   {}{}", b.what, b.seconds, bytes.join(", "), total);
-        println!("{}", line.trim_end());
+        outln!("{}", line.trim_end());
     }
     for r in &s.rays {
         print_rays(r, baseline, passes);
@@ -29,7 +23,7 @@ pub fn print_scene(s: &SceneReport, baseline: &str, passes: usize) {
 fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
     let threads: Vec<usize> = dedup(r.rows.iter().map(|row| row.threads));
     let any = r.kind.query() == raytrail::core::traverse::Query::Any;
-    println!(
+    outln!(
         "\n{} rays: {} ({} hit); Mrays/s = median of {passes} pass{}; ratio = speed / {baseline} at the same threads",
         r.kind.name(),
         thousands(r.rays as u64),
@@ -44,7 +38,7 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
     }
     header += &format!(" {:>9} {:>10} {:>9}", "nodes/ray", "leaves/ray", "tests/ray");
     header += if any { "  same occlusion" } else { "  same hit  within 1e-5" };
-    println!("{header}");
+    outln!("{header}");
     for (name, agreement) in &r.agreement {
         let mut line = format!("  {name:<width$}");
         let mut work = None;
@@ -65,7 +59,7 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
         } else {
             line += &format!("  {:>7.3}%  {:>10.3}%", agreement.exact_pct(), agreement.close_pct());
         }
-        println!("{line}");
+        outln!("{line}");
     }
     if let Some(&most) = threads.last() {
         let best = |raytrail: bool| {
@@ -75,7 +69,7 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
                 .max_by(|a, b| a.mrays_per_s.total_cmp(&b.mrays_per_s))
         };
         if let (Some(ours), Some(peer)) = (best(true), best(false)) {
-            println!(
+            outln!(
                 "  fastest at {most} thr: raytrail {} {:.2}, peer {} {:.2}: raytrail at {:.2}x the fastest peer",
                 ours.target,
                 ours.mrays_per_s,
@@ -97,7 +91,7 @@ fn print_rays(r: &RayReport, baseline: &str, passes: usize) {
         })
         .collect();
     if !notes.is_empty() {
-        println!("  disagreements with stack: {}", notes.join("; "));
+        outln!("  disagreements with stack: {}", notes.join("; "));
     }
 }
 
@@ -119,15 +113,23 @@ fn print_stream_stages(r: &RayReport) {
     if rows.is_empty() {
         return;
     }
-    println!(
+    outln!(
         "  stream stages, ms (median of 3 runs):  {:>7} {:>9} {:>9} {:>12}  {:>8} {:>8} {:>9} {:>8} {:>9}",
-        "sort", "frustums", "traversal", "intersection", "packets", "rays/pk", "leaves/pk", "longest", "work MB"
+        "sort",
+        "frustums",
+        "traversal",
+        "intersection",
+        "packets",
+        "rays/pk",
+        "leaves/pk",
+        "longest",
+        "work MB"
     );
     for row in rows {
         let Some(st) = &row.stream else { continue };
         let ms = |s: f64| s * 1e3;
         let per = |x: usize| x as f64 / st.packets.max(1) as f64;
-        println!(
+        outln!(
             "  {:<38} {:>7.1} {:>9.1} {:>9.1} {:>12.1}  {:>8} {:>8.1} {:>9.1} {:>8} {:>9.1}",
             row.target,
             ms(st.seconds.sort),
@@ -160,15 +162,19 @@ fn print_gpu_kernels(r: &RayReport) {
     if rows.is_empty() {
         return;
     }
-    println!(
+    outln!(
         "  GPU Mrays/s:                           {:>10} {:>10} {:>19} {:>9} {:>10}",
-        "end to end", "kernel", "kernel min-max", "MB moved", "GB/s e2e"
+        "end to end",
+        "kernel",
+        "kernel min-max",
+        "MB moved",
+        "GB/s e2e"
     );
     for row in rows {
         let Some(k) = &row.kernel else { continue };
         let (lo, hi) = k.spread();
         let gbs = if row.median_s > 0.0 { k.bytes_per_trace as f64 / row.median_s / 1e9 } else { 0.0 };
-        println!(
+        outln!(
             "  {:<38} {:>10.1} {:>10.1} {:>9.1}-{:<9.1} {:>9.1} {:>10.2}",
             row.target,
             row.mrays_per_s,
