@@ -24,19 +24,31 @@ pub struct LoadFlags {
     /// Largest size a gzip-compressed mesh may inflate to, in bytes
     #[arg(long, value_name = "BYTES", default_value_t = LoadOptions::DEFAULT_MAX_INFLATED)]
     pub max_mesh_bytes: u64,
+    /// Most triangles a mesh may make (after polygons are split and glTF nodes place their meshes)
+    #[arg(long, value_name = "N", default_value_t = LoadOptions::DEFAULT_MAX_TRIANGLES)]
+    pub max_triangles: u64,
 }
 
 impl Default for LoadFlags {
     /// The defaults the command line has.
     fn default() -> Self {
-        LoadFlags { strict: false, max_mesh_bytes: LoadOptions::DEFAULT_MAX_INFLATED }
+        LoadFlags {
+            strict: false,
+            max_mesh_bytes: LoadOptions::DEFAULT_MAX_INFLATED,
+            max_triangles: LoadOptions::DEFAULT_MAX_TRIANGLES,
+        }
     }
 }
 
 impl LoadFlags {
     /// The mesh loading policy of [`STRICT`].
     pub fn load_options(&self) -> LoadOptions {
-        LoadOptions { strict: self.strict, max_inflated: self.max_mesh_bytes, ..LoadOptions::default() }
+        LoadOptions {
+            strict: self.strict,
+            max_inflated: self.max_mesh_bytes,
+            max_triangles: self.max_triangles,
+            ..LoadOptions::default()
+        }
     }
 }
 

@@ -109,8 +109,30 @@ fn parse_checked(
         report: LoadReport::default(),
         options,
     };
-    for (node, mesh, world) in instances(&root).map_err(err)? {
-        loader.add_mesh(node, mesh, &world).map_err(err)?;
+    // Each mesh decoded once, then the placed totals checked against the limit before any copy
+    // is made: instancing multiplies a file's triangles by its node count.
+    let placements = instances(&root).map_err(err)?;
+    let mut decoded: Vec<Option<Decoded>> = (0..root.meshes.len()).map(|_| None).collect();
+    let (mut vertices, mut triangles) = (0u64, 0u64);
+    for &(_, m, _) in &placements {
+        if decoded[m].is_none() {
+            decoded[m] = Some(loader.decode(m).map_err(err)?);
+        }
+        let (v, t) = decoded[m].as_ref().map_or((0, 0), Decoded::size);
+        (vertices, triangles) = (vertices.saturating_add(v), triangles.saturating_add(t));
+    }
+    super::check_triangles(triangles, "the scene's nodes place", options).map_err(err)?;
+    let max_vertices = options.max_triangles.saturating_mul(3);
+    if vertices > max_vertices {
+        return Err(err(format!(
+            "the scene's nodes place {vertices} vertices, more than three per allowed triangle ({max_vertices}; LoadOptions::max_triangles, the CLI's --max-triangles)"
+        )));
+    }
+    loader.reserve(vertices, triangles).map_err(err)?;
+    for (node, m, world) in placements {
+        if let Some(mesh) = &decoded[m] {
+            loader.place(node, m, mesh, &world).map_err(err)?;
+        }
     }
     Ok((loader.mesh, loader.report))
 }
@@ -239,10 +261,34 @@ struct Loader<'a> {
     options: &'a LoadOptions,
 }
 
+/// A mesh's primitives, decoded once however many nodes place it.
+struct Decoded {
+    primitives: Vec<Primitive>,
+}
+
+/// One primitive of a decoded mesh.
+enum Primitive {
+    /// Not triangles (a line or point mode, or no POSITION), counted in the report per placement.
+    Skipped(String),
+    /// Its vertices and triangles (indices into its own vertices).
+    Triangles { positions: Vec<Vec3>, triangles: Vec<[u32; 3]> },
+}
+
+impl Decoded {
+    /// Vertices and triangles one placement of the mesh adds.
+    fn size(&self) -> (u64, u64) {
+        self.primitives.iter().fold((0, 0), |(v, t), p| match p {
+            Primitive::Skipped(_) => (v, t),
+            Primitive::Triangles { positions, triangles } => (v + positions.len() as u64, t + triangles.len() as u64),
+        })
+    }
+}
+
 impl Loader<'_> {
-    /// Appends every primitive of mesh `m`, placed by node `node`'s transform.
-    fn add_mesh(&mut self, node: usize, m: usize, world: &Mat4) -> Result<(), String> {
+    /// Decodes every primitive of mesh `m`: its vertices and triangles, or why it is skipped.
+    fn decode(&mut self, m: usize) -> Result<Decoded, String> {
         let root = self.root;
+        let mut primitives = Vec::new();
         for (p, primitive) in root.meshes[m].primitives.iter().enumerate() {
             let path = format!("meshes[{m}].primitives[{p}]");
             let mode = match primitive.mode {
@@ -269,7 +315,7 @@ impl Loader<'_> {
                 if self.options.strict {
                     return Err(format!("{path}: {what} is not triangles"));
                 }
-                self.report.skip(|| format!("mesh {m} primitive {p} (node {node})"), || what);
+                primitives.push(Primitive::Skipped(what));
                 continue;
             }
             let Some(position) = position else { continue };
@@ -291,14 +337,31 @@ impl Loader<'_> {
                 }
             };
             let triangles = triangles(mode, &indices).map_err(|e| format!("{path}: {e}"))?;
+            primitives.push(Primitive::Triangles { positions, triangles });
+        }
+        Ok(Decoded { primitives })
+    }
+
+    /// Appends every primitive of mesh `m` (decoded as `mesh`), placed by node `node`'s transform.
+    fn place(&mut self, node: usize, m: usize, mesh: &Decoded, world: &Mat4) -> Result<(), String> {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let (positions, triangles) = match primitive {
+                Primitive::Skipped(what) => {
+                    self.report.skip(|| format!("mesh {m} primitive {p} (node {node})"), || what.clone());
+                    continue;
+                }
+                Primitive::Triangles { positions, triangles } => (positions, triangles),
+            };
             let base = self.mesh.positions.len() as u64;
             if base + positions.len() as u64 > MAX_VERTICES
                 || (self.mesh.triangles.len() + triangles.len()) as u64 > MAX_TRIANGLES
             {
-                return Err(format!("{path} (node {node}): the mesh would have more than 2^32 vertices or triangles"));
+                return Err(format!(
+                    "meshes[{m}].primitives[{p}] (node {node}): the mesh would have more than 2^32 vertices or triangles"
+                ));
             }
             if *world == Mat4::IDENTITY {
-                self.mesh.positions.extend_from_slice(&positions);
+                self.mesh.positions.extend_from_slice(positions);
             } else {
                 self.mesh.positions.extend(positions.iter().map(|&v| world.transform_point3(v)));
             }
@@ -309,6 +372,20 @@ impl Loader<'_> {
                 let n = triangles.len() as u32;
                 self.report.sources.extend((0..n).map(|triangle| Source::Gltf { node, mesh, primitive, triangle }));
             }
+        }
+        Ok(())
+    }
+
+    /// Reserves room for `vertices` and `triangles` (and their sources) up front, failing with an
+    /// error rather than aborting when the memory is not there.
+    fn reserve(&mut self, vertices: u64, triangles: u64) -> Result<(), String> {
+        let cannot = |what: &str, n: u64| format!("cannot hold {n} {what} in memory");
+        let v = usize::try_from(vertices).map_err(|_| cannot("vertices", vertices))?;
+        let t = usize::try_from(triangles).map_err(|_| cannot("triangles", triangles))?;
+        self.mesh.positions.try_reserve_exact(v).map_err(|_| cannot("vertices", vertices))?;
+        self.mesh.triangles.try_reserve_exact(t).map_err(|_| cannot("triangles", triangles))?;
+        if self.options.sources {
+            self.report.sources.try_reserve_exact(t).map_err(|_| cannot("triangle sources", triangles))?;
         }
         Ok(())
     }
@@ -663,6 +740,63 @@ mod tests {
                 2 * n
             ),
         )
+    }
+
+    /// One square (two triangles) placed by `nodes` nodes, each a root of the scene.
+    fn square_placed(nodes: usize) -> Vec<u8> {
+        let list: Vec<String> = (0..nodes).map(|_| r#"{"mesh":0}"#.to_string()).collect();
+        let roots: Vec<String> = (0..nodes).map(|i| i.to_string()).collect();
+        square_gltf(
+            4,
+            &[0, 1, 2, 0, 2, 3],
+            &format!(r#""nodes":[{}],"scenes":[{{"nodes":[{}]}}]"#, list.join(","), roots.join(",")),
+        )
+    }
+
+    #[test]
+    fn instancing_past_the_triangle_limit_is_an_error_before_the_copies_are_made() {
+        let options = |max| LoadOptions { max_triangles: max, ..LoadOptions::default() };
+        let file = square_placed(1000);
+        let (mesh, _) = parse(&file, "t.gltf", None, &options(2000)).unwrap();
+        assert_eq!((mesh.triangles.len(), mesh.positions.len()), (2000, 4000));
+        let err = parse(&file, "t.gltf", None, &options(1999)).unwrap_err().to_string();
+        assert!(err.contains("the scene's nodes place 2000 triangles, more than the limit of 1999"), "{err}");
+        assert!(err.contains("--max-triangles"), "{err}");
+        // Placed vertices are held to three per allowed triangle: one triangle of the square's four
+        // vertices, placed 1000 times, is 1000 triangles and 4000 vertices.
+        let one = String::from_utf8(file).unwrap().replace(r#""count":6"#, r#""count":3"#).into_bytes();
+        assert!(parse(&one, "t.gltf", None, &options(1334)).is_ok());
+        let err = parse(&one, "t.gltf", None, &options(1333)).unwrap_err().to_string();
+        assert!(err.contains("place 4000 vertices, more than three per allowed triangle (3999;"), "{err}");
+    }
+
+    #[test]
+    fn an_instancing_bomb_is_refused_under_the_default_limit() {
+        // The shape of the reported file: 20,000 nodes placing one mesh, here of 4,096 triangles
+        // (82 million placed, past the default 2^26); refused before the copies, in a few
+        // megabytes of memory rather than gigabytes.
+        let k = 4096u32;
+        let mut bin = floats(&[0., 0., 0., 1., 0., 0., 0., 1., 0.]);
+        bin.extend((0..3 * k).flat_map(|i| ((i % 3) as u16).to_le_bytes()));
+        let nodes: Vec<String> = (0..20_000).map(|_| r#"{"mesh":0}"#.to_string()).collect();
+        let roots: Vec<String> = (0..20_000).map(|i| i.to_string()).collect();
+        let file = gltf(
+            &bin,
+            &format!(
+                r#""bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":{}}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}},
+{{"bufferView":1,"componentType":5123,"count":{},"type":"SCALAR"}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+"nodes":[{}],"scenes":[{{"nodes":[{}]}}]"#,
+                6 * k,
+                3 * k,
+                nodes.join(","),
+                roots.join(",")
+            ),
+        );
+        assert!(file.len() < 1 << 20, "{} bytes", file.len());
+        let err = load(&file).unwrap_err();
+        assert!(err.contains("the scene's nodes place 81920000 triangles, more than the limit of 67108864"), "{err}");
     }
 
     #[test]

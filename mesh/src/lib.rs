@@ -29,7 +29,10 @@
 //! Every failure is a [`MeshError`] naming the file and, where there is one, the line (text), the
 //! byte offset (binary) or the JSON path (glTF). Counts that a file claims (PLY and OFF headers,
 //! STL's triangle count, glTF accessors) never size an allocation beyond what the data can hold,
-//! and no input makes a loader panic.
+//! and no input makes a loader panic. What a file may expand to is limited: gzip data by
+//! [`LoadOptions::max_inflated`], triangles (after fan splitting and glTF instancing, which
+//! multiplies a mesh by the nodes that place it) by [`LoadOptions::max_triangles`], checked before
+//! the triangles are allocated.
 
 #![warn(missing_docs)]
 
@@ -59,6 +62,11 @@ pub struct LoadOptions {
     /// Largest size a gzip-compressed file may inflate to, in bytes; past it loading fails with
     /// an error saying so (a few megabytes of gzip can claim gigabytes).
     pub max_inflated: u64,
+    /// Most triangles a file may make, counted after polygons are split into fans and after glTF
+    /// instancing (a node placing a mesh copies it); past it loading fails before the triangles
+    /// are allocated, with an error saying so (a 1 MB glTF that places one mesh 20,000 times makes
+    /// over a hundred million). glTF's placed vertices are held to three per allowed triangle.
+    pub max_triangles: u64,
 }
 
 impl Default for LoadOptions {
@@ -70,14 +78,33 @@ impl Default for LoadOptions {
 
 impl LoadOptions {
     /// The default policy: skip elements that are not triangles or polygons, no source map.
-    pub const LENIENT: LoadOptions =
-        LoadOptions { strict: false, sources: false, max_inflated: LoadOptions::DEFAULT_MAX_INFLATED };
+    pub const LENIENT: LoadOptions = LoadOptions {
+        strict: false,
+        sources: false,
+        max_inflated: LoadOptions::DEFAULT_MAX_INFLATED,
+        max_triangles: LoadOptions::DEFAULT_MAX_TRIANGLES,
+    };
     /// Fail on elements that are not triangles or polygons.
     pub const STRICT: LoadOptions = LoadOptions { strict: true, ..LoadOptions::LENIENT };
     /// The default [`LoadOptions::max_inflated`]: 512 MiB, far beyond any mesh the tests or
     /// benches read (the full dragon inflates to 30 MB), and reached by a gzip bomb in well under a
     /// second (a 3 MB file that claims 3 GB is stopped there).
     pub const DEFAULT_MAX_INFLATED: u64 = 512 << 20;
+    /// The default [`LoadOptions::max_triangles`]: 2^26 (67 million), 77 times the full dragon;
+    /// at the limit a mesh holds about 0.8 GiB of triangles and up to 2.3 GiB of vertices.
+    pub const DEFAULT_MAX_TRIANGLES: u64 = 1 << 26;
+}
+
+/// `Err` naming the limit when `count` triangles (what `what` makes: "the faces make") pass
+/// [`LoadOptions::max_triangles`]; checked before the triangles are allocated.
+fn check_triangles(count: u64, what: &str, options: &LoadOptions) -> Result<(), String> {
+    let max = options.max_triangles;
+    if count > max {
+        return Err(std::format!(
+            "{what} {count} triangles, more than the limit of {max} (LoadOptions::max_triangles; the CLI's --max-triangles)"
+        ));
+    }
+    Ok(())
 }
 
 /// What loading a file skipped, and where the triangles came from.
@@ -416,6 +443,33 @@ endloop\nendfacet\nendsolid t\n";
         assert!(err.contains("inflates to more than 1048576 bytes"), "{err}");
         // Under the default limit the same file inflates (and is an OBJ of comments: no triangles).
         assert!(load_bytes(&small, "bomb.obj.gz").map(|m| m.triangles.is_empty()).unwrap_or(true));
+    }
+
+    #[test]
+    fn every_format_refuses_triangles_past_the_limit() {
+        let quad_ply = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+        let quad_off = b"OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+        let quad_stl = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\n\
+vertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+        let mut binary_stl = std::vec![0u8; 80];
+        binary_stl.extend(2u32.to_le_bytes());
+        binary_stl.extend(std::vec![0u8; 100]);
+        let files: [(&str, &[u8]); 5] = [
+            ("q.obj", QUAD_OBJ),
+            ("q.ply", quad_ply),
+            ("q.off", quad_off),
+            ("q.stl", quad_stl),
+            ("b.stl", &binary_stl),
+        ];
+        for (name, data) in files {
+            // Each file makes two triangles (a quad split in two, or two binary facets).
+            let at = |max| load_bytes_with(data, name, &LoadOptions { max_triangles: max, ..LoadOptions::default() });
+            assert_eq!(at(2).map(|(m, _)| m.triangles.len()).map_err(|e| e.to_string()), Ok(2), "{name}");
+            let err = at(1).unwrap_err().to_string();
+            assert!(err.contains("2 triangles, more than the limit of 1 (LoadOptions::max_triangles"), "{name}: {err}");
+        }
     }
 
     #[test]

@@ -32,6 +32,8 @@ use std::vec::Vec;
 /// Parses OBJ text; `name` is used in errors.
 pub(super) fn parse(data: &[u8], name: &str, options: &LoadOptions) -> Result<(Mesh, LoadReport), MeshError> {
     let mut scan = prescan(data, options);
+    // Before tobj allocates them: its triangle count is the pre-scan's (see the module comment).
+    super::check_triangles(scan.triangles, "the `f` lines make", options).map_err(|e| MeshError::new(name, e))?;
     let text: Cow<[u8]> = if scan.comment_out.is_empty() {
         Cow::Borrowed(data)
     } else {
@@ -144,10 +146,12 @@ struct Prescan {
     strict_error: Option<(usize, String)>,
     /// Elements skipped, and the sources of the triangles of the kept faces.
     report: LoadReport,
+    /// Triangles the kept faces make (`n - 2` for a face of `n` vertices).
+    triangles: u64,
 }
 
 fn prescan(data: &[u8], options: &LoadOptions) -> Prescan {
-    let mut scan = Prescan { comment_out: Vec::new(), strict_error: None, report: LoadReport::default() };
+    let mut scan = Prescan { comment_out: Vec::new(), strict_error: None, report: LoadReport::default(), triangles: 0 };
     for (i, (start, line)) in lines(data).enumerate() {
         let line_no = i + 1;
         // Words as tobj splits them (Unicode whitespace) where the line is text it can read.
@@ -176,7 +180,9 @@ fn prescan(data: &[u8], options: &LoadOptions) -> Prescan {
                 Some((what, format!("face has {count} vertices; a face needs at least 3")))
             }
             Some(b"f") => {
-                if options.sources {
+                scan.triangles += (count - 2) as u64;
+                // Sources only while within the limit: past it the load fails before tobj runs.
+                if options.sources && scan.triangles <= options.max_triangles {
                     let n = count - 2;
                     scan.report.sources.extend(core::iter::repeat_n(Source::Line(line_no as u64), n));
                 }

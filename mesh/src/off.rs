@@ -133,6 +133,8 @@ pub(super) fn parse(data: &[u8], name: &str, options: &LoadOptions) -> Result<(M
             if mesh.triangles.len() as u64 >= MAX_TRIANGLES {
                 return Err(here("more than 2^32 - 1 triangles".into()));
             }
+            super::check_triangles(mesh.triangles.len() as u64 + 1, "the faces up to here make", options)
+                .map_err(here)?;
             mesh.triangles.push([v0, prev, next]);
             prev = next;
         }

@@ -35,7 +35,9 @@ pub(super) fn parse(data: &[u8], name: &str, options: &LoadOptions) -> Result<(M
     for el in &header.elements {
         match el.kind {
             ElementKind::Vertex => out.mesh.positions.reserve(el.count.min(data.len() / 4)),
-            ElementKind::Face => out.mesh.triangles.reserve(el.count.min(data.len() / 4)),
+            ElementKind::Face => out.mesh.triangles.reserve(
+                el.count.min(data.len() / 4).min(usize::try_from(options.max_triangles).unwrap_or(usize::MAX)),
+            ),
             ElementKind::Other => {}
         }
     }
@@ -399,6 +401,7 @@ fn read_face(v: &mut impl Values, n: i64, item: Scalar, out: &mut Out) -> Result
     let mut prev = index()?;
     for _ in 2..n {
         let next = index()?;
+        super::check_triangles(out.mesh.triangles.len() as u64 + 1, "the faces up to here make", &out.options)?;
         out.mesh.triangles.push([first, prev, next]);
         prev = next;
     }

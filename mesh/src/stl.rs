@@ -84,6 +84,7 @@ fn parse_binary(data: &[u8], name: &str, options: &LoadOptions) -> Result<(Mesh,
     if facets as u64 > MAX_TRIANGLES || 3 * facets as u64 > MAX_VERTICES {
         return Err(MeshError::new(name, format!("{facets} facets: more than 2^32 vertices")));
     }
+    super::check_triangles(facets as u64, "the file's facets make", options).map_err(|e| MeshError::new(name, e))?;
     let mut mesh = Mesh::default();
     mesh.positions.reserve(3 * facets);
     mesh.triangles.reserve(facets);
@@ -168,6 +169,9 @@ fn parse_ascii(data: &[u8], name: &str, options: &LoadOptions) -> Result<(Mesh, 
                 if base + n as u64 > MAX_VERTICES || (mesh.triangles.len() + n - 2) as u64 > MAX_TRIANGLES {
                     return Err(MeshError::at_line(name, facet_line, "more than 2^32 vertices"));
                 }
+                let made = (mesh.triangles.len() + n - 2) as u64;
+                super::check_triangles(made, "the facets up to here make", options)
+                    .map_err(|e| MeshError::at_line(name, facet_line, e))?;
                 mesh.positions.extend_from_slice(&corners);
                 let base = base as u32;
                 mesh.triangles.extend((1..n as u32 - 1).map(|i| [base, base + i, base + i + 1]));
