@@ -98,6 +98,7 @@ pub use raytrail_mesh as mesh;
 pub use raytrail_wgpu as gpu;
 
 pub use raytrail_build::Builder;
+pub use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 pub use raytrail_core::glam::Vec3;
 pub use raytrail_core::method::{Method, Query};
 pub use raytrail_core::{Hit, Ray};

@@ -10,6 +10,7 @@
 
 use crate::analysis::sample::choose_among;
 use crate::{Builder, Error};
+use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::method::{Method, Query, WideMethod};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::scene::{Mesh, Scene};
@@ -210,6 +211,74 @@ impl Tracer {
         let mut hit = [Hit::MISS];
         self.trace(std::slice::from_ref(ray), Query::Any, &mut hit)?;
         Ok(one(hit[0])?.is_some())
+    }
+
+    /// Every hit of each ray within its interval, in order of `t` (ties by primitive id), each
+    /// triangle at most once, as `options` keep them: at most [`AllHitsOptions::max_hits`] per
+    /// ray (the nearest, the list marked truncated), and hits at one `t` merged where asked. A
+    /// ray through an edge two triangles share gets both triangles, once each, at one `t`. Each
+    /// hit is bit for bit the closest hit the ray would have if the triangle were alone in the
+    /// scene, so a list's first hit is [`Tracer::intersect`]'s.
+    ///
+    /// ```
+    /// use raytrail::{AllHitsOptions, Ray, Tracer, Vec3};
+    /// # fn main() -> Result<(), raytrail::Error> {
+    /// // Two parallel triangles, at z = 0 and z = -1.
+    /// let vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 1.0, -1.0]];
+    /// let tracer = Tracer::new(&vertices, &[[0, 1, 2], [3, 4, 5]])?;
+    /// let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, 0.0, f32::INFINITY);
+    /// let lists = tracer.intersect_all(&[ray], &AllHitsOptions::default())?;
+    /// let hits: Vec<(u32, f32)> = lists.ray(0).unwrap().iter().map(|h| (h.prim, h.t)).collect();
+    /// assert_eq!(hits, [(0, 1.0), (1, 2.0)]);
+    /// # Ok(())
+    /// # }
+    /// ```
+    ///
+    /// The lists come from the scene's wide tree: [`Error::NotPrepared`](raytrail_core::Error::NotPrepared)
+    /// for a tracer built for a BVH2, kd or stream method alone ([`TracerBuilder::method`]).
+    pub fn intersect_all(&self, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
+        if self.reject_untraceable {
+            if let Some(first) = rays.iter().position(|r| !r.is_traceable()) {
+                let count = raytrail_core::trace::count_untraceable(&rays[first..]);
+                return Err(Error::UntraceableRays { count, first });
+            }
+        }
+        Ok(self.backend.all_hits(&self.scene, rays, options)?)
+    }
+
+    /// Moves the scene's triangles to new vertex positions (the same triangles by index, as an
+    /// animation frame or a simulation step gives them): the tree is refitted in linear time
+    /// rather than built again ([`PreparedScene::refit`]). Hits afterwards are bit for bit those
+    /// of a tracer built from the new vertices; tracing slows as the triangles move far from where
+    /// the tree was built, and a new tracer is then the faster choice. An error (another triangle
+    /// count, an index out of range, a vertex that is not finite) leaves the tracer as it was.
+    ///
+    /// ```
+    /// use raytrail::{Ray, Tracer, Vec3};
+    /// # fn main() -> Result<(), raytrail::Error> {
+    /// let triangle = [[0, 1, 2]];
+    /// let mut tracer = Tracer::new(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &triangle)?;
+    /// // The triangle moves up by 0.5: the ray from z = 1 now meets it at t = 0.5.
+    /// tracer.refit(&[[0.0, 0.0, 0.5], [1.0, 0.0, 0.5], [0.0, 1.0, 0.5]], &triangle)?;
+    /// let hit = tracer.intersect_one(&Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, 0.0, f32::INFINITY))?;
+    /// assert_eq!(hit.map(|h| h.t), Some(0.5));
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn refit(&mut self, vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<(), Error> {
+        self.refit_scene(&Scene::from_indexed(vertices, triangles)?)
+    }
+
+    /// [`Tracer::refit`] to a loaded mesh's vertices.
+    pub fn refit_mesh(&mut self, mesh: &Mesh) -> Result<(), Error> {
+        self.refit_scene(&mesh.to_scene()?)
+    }
+
+    /// [`Tracer::refit`] to a scene of the same number of triangles.
+    pub fn refit_scene(&mut self, scene: &Scene) -> Result<(), Error> {
+        // A prepared scene the caller still holds ([`Tracer::prepared`]) is copied, not changed.
+        Arc::make_mut(&mut self.scene.0).refit(scene)?;
+        Ok(())
     }
 
     /// The method this tracer would trace `rays` with for `query`: the one it was built for, or

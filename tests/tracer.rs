@@ -191,3 +191,32 @@ fn the_chunk_check_frames_as_needs_framing_and_counts_as_is_traceable() {
     let report = backend.trace(&cpu, &rays, &TraceOptions::new(Bvh2Method::Stack), &mut hits).unwrap();
     assert_eq!(report.untraceable, untraceable);
 }
+
+#[test]
+fn a_refitted_tracer_answers_as_one_built_from_the_moved_vertices() {
+    let scene = generated_scene("sphereflake").scene;
+    let (vertices, triangles) = arrays(&scene);
+    let mut tracer = Tracer::new(&vertices, &triangles).unwrap();
+    let held = tracer.prepared().clone();
+    for phase in [0.8f32, 2.5] {
+        let moved = raytrail_conformance::scenes::breathing(&scene, phase).unwrap();
+        let (moved_vertices, _) = arrays(&moved);
+        tracer.refit(&moved_vertices, &triangles).unwrap();
+        let camera = primary(&moved, 320, 240);
+        let want = stack_hits(&moved, &camera, Query::Closest);
+        let got = tracer.intersect(&camera).unwrap();
+        assert!(got.iter().zip(&want).all(|(a, b)| a.same_as(b)), "phase {phase}: hits differ from a fresh tree's");
+        let b = moved.bounds();
+        let shadows = shadow(&camera, &want, default_light(b), scene_epsilon(b));
+        let want_any = stack_hits(&moved, &shadows, Query::Any);
+        let blocked = tracer.occluded(&shadows).unwrap();
+        assert!(blocked.iter().zip(&want_any).all(|(&o, h)| o == h.is_hit()), "phase {phase}: occlusion differs");
+    }
+    // The prepared scene held before the refits is the unmoved one still.
+    held.bvh.check_bounds(scene.triangles()).unwrap();
+    // A refit to another triangle count is an error that leaves the tracer as it was.
+    let before = tracer.intersect(&primary(&scene, 64, 48)).unwrap();
+    let err = tracer.refit(&vertices, &triangles[1..]).unwrap_err();
+    assert!(matches!(err, Error::Core(raytrail::core::Error::TreeMismatch { .. })), "{err:?}");
+    assert!(tracer.intersect(&primary(&scene, 64, 48)).unwrap().iter().zip(&before).all(|(a, b)| a.same_as(b)));
+}

@@ -207,15 +207,7 @@ pub fn compare(ctx: Context<'_>, rays: &[Ray], outcomes: &[Outcome]) -> Vec<Mism
             find(Method::Bvh2(Bvh2Method::Stack), o.query).filter(|_| o.method != Method::Bvh2(Bvh2Method::Stack))
         {
             for (i, (e, g)) in stack.hits.iter().zip(&o.hits).enumerate() {
-                let differs = match o.query {
-                    Query::Closest => !e.same_as(g),
-                    Query::Any => e.is_hit() != g.is_hit(),
-                };
-                if differs {
-                    let d = match o.query {
-                        Query::Closest => Difference::Hit { expected: *e, got: *g },
-                        Query::Any => Difference::Occlusion { expected: e.is_hit(), got: g.is_hit() },
-                    };
+                if let Some(d) = hit_difference(o.query, e, g) {
                     out.push(mismatch(i, Method::Bvh2(Bvh2Method::Stack), d));
                 }
             }
@@ -232,20 +224,37 @@ pub fn compare(ctx: Context<'_>, rays: &[Ray], outcomes: &[Outcome]) -> Vec<Mism
     out
 }
 
-/// Compares a backend's outcomes with the CPU's for the same methods and query, ray by ray:
-/// hits bit for bit (any hit: occluded or not) and enumerations exactly. The mismatches name the
-/// backend as `ctx.backend` and the method as its own reference.
-pub fn compare_backends(ctx: Context<'_>, rays: &[Ray], cpu: &[Outcome], other: &[Outcome]) -> Vec<Mismatch> {
+/// How a hit `g` differs from the expected `e` for `query`: a closest hit bit for bit, an any
+/// hit by whether the ray is occluded at all.
+fn hit_difference(query: Query, e: &Hit, g: &Hit) -> Option<Difference> {
+    match query {
+        Query::Closest => (!e.same_as(g)).then_some(Difference::Hit { expected: *e, got: *g }),
+        Query::Any => {
+            (e.is_hit() != g.is_hit()).then_some(Difference::Occlusion { expected: e.is_hit(), got: g.is_hit() })
+        }
+    }
+}
+
+/// Compares outcomes with expected ones for the same methods and query, ray by ray: hits bit for
+/// bit (any hit: occluded or not) and the counts of untraceable and refused rays. The mismatches
+/// name the backend as `versus` ("wgpu vs cpu") and the method as its own reference.
+pub fn compare_hits(
+    ctx: Context<'_>,
+    versus: &str,
+    rays: &[Ray],
+    expected: &[Outcome],
+    got: &[Outcome],
+) -> Vec<Mismatch> {
     let mut out = Vec::new();
-    for o in other {
-        let Some(c) = cpu.iter().find(|c| c.method == o.method && c.query == o.query) else {
+    for o in got {
+        let Some(c) = expected.iter().find(|c| c.method == o.method && c.query == o.query) else {
             continue;
         };
         let mut push = |i: usize, difference: Difference| {
             out.push(Mismatch {
                 scene: ctx.scene.to_string(),
                 ray_set: ctx.ray_set.to_string(),
-                backend: format!("{} vs cpu", ctx.backend),
+                backend: versus.to_string(),
                 method: o.method,
                 reference: o.method,
                 query: o.query,
@@ -255,18 +264,8 @@ pub fn compare_backends(ctx: Context<'_>, rays: &[Ray], cpu: &[Outcome], other: 
             })
         };
         for (i, (e, g)) in c.hits.iter().zip(&o.hits).enumerate() {
-            let differs = match o.query {
-                Query::Closest => !e.same_as(g),
-                Query::Any => e.is_hit() != g.is_hit(),
-            };
-            if differs {
-                push(
-                    i,
-                    match o.query {
-                        Query::Closest => Difference::Hit { expected: *e, got: *g },
-                        Query::Any => Difference::Occlusion { expected: e.is_hit(), got: g.is_hit() },
-                    },
-                );
+            if let Some(d) = hit_difference(o.query, e, g) {
+                push(i, d);
             }
         }
         // The counts against the rays and hits themselves: every backend counts alike.
@@ -277,12 +276,36 @@ pub fn compare_backends(ctx: Context<'_>, rays: &[Ray], cpu: &[Outcome], other: 
                 push(0, Difference::Count { what, expected, got });
             }
         }
+    }
+    out
+}
+
+/// Compares a backend's outcomes with the CPU's for the same methods and query, ray by ray:
+/// hits bit for bit (any hit: occluded or not), the counts ([`compare_hits`]) and enumerations
+/// exactly. The mismatches name the backend as `ctx.backend` and the method as its own reference.
+pub fn compare_backends(ctx: Context<'_>, rays: &[Ray], cpu: &[Outcome], other: &[Outcome]) -> Vec<Mismatch> {
+    let versus = format!("{} vs cpu", ctx.backend);
+    let mut out = compare_hits(ctx, &versus, rays, cpu, other);
+    for o in other {
+        let Some(c) = cpu.iter().find(|c| c.method == o.method && c.query == o.query) else {
+            continue;
+        };
         // Indexed by the reference's enumerations, so a backend that recorded none (or too few)
         // mismatches instead of being compared over nothing.
         for (i, e) in c.enumerations.iter().enumerate() {
             let g = o.enumerations.get(i).map_or(&[][..], Vec::as_slice);
             if e.as_slice() != g {
-                push(i, Difference::Enumeration { expected: e.clone(), got: g.to_vec() });
+                out.push(Mismatch {
+                    scene: ctx.scene.to_string(),
+                    ray_set: ctx.ray_set.to_string(),
+                    backend: versus.clone(),
+                    method: o.method,
+                    reference: o.method,
+                    query: o.query,
+                    ray_index: i,
+                    ray: rays[i],
+                    difference: Difference::Enumeration { expected: e.clone(), got: g.to_vec() },
+                });
             }
         }
     }

@@ -13,6 +13,7 @@
 //! [`Method::reference`]: raytrail_core::method::Method::reference
 #![warn(missing_docs)]
 
+pub mod all_hits;
 pub mod check;
 pub mod exact;
 pub mod paths;

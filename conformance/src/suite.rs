@@ -8,14 +8,14 @@
 //! the [`SerialBackend`] ([`compare_backends`](crate::check::compare_backends)). A method the
 //! backend does not support fails the case: the suite never passes over a method in silence.
 
-use crate::check::{check_against, check_complete, leaf_of_prim, Context, Mismatch};
+use crate::check::{check_against, check_complete, compare_hits, leaf_of_prim, trace_all, Context, Mismatch};
 use crate::paths::{find_mesh, load_mesh_scene};
 use crate::rays::{ray_sets, RaySetSize};
 use crate::reference::SerialBackend;
-use crate::scenes::{generated, tiny_cases, NamedScene};
+use crate::scenes::{breathing, generated, tiny_cases, NamedScene};
 use raytrail_core::bvh2::{Bvh2, SahBuilder};
 use raytrail_core::key::KeyWidth;
-use raytrail_core::method::{Bvh2Method, Method, WideMethod};
+use raytrail_core::method::{Bvh2Method, Method, Query, WideMethod};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{Record, Trace, TraceOptions};
 use raytrail_core::wide::keyed::wide_key_width;
@@ -33,6 +33,9 @@ pub const REQUIRE_GPU: &str = "RAYTRAIL_REQUIRE_GPU";
 pub const MESH_RAYS: RaySetSize = RaySetSize { width: 64, height: 48, uniform_count: 4096 };
 /// Ray set sizes for the generated scenes.
 pub const GENERATED_RAYS: RaySetSize = RaySetSize { width: 96, height: 72, uniform_count: 8192 };
+/// Ray set sizes for the refit case (a quarter of [`GENERATED_RAYS`]: it traces its scene twice
+/// over, and what it adds to the generated cases is the refit, not the rays).
+pub const REFIT_RAYS: RaySetSize = RaySetSize { width: 48, height: 36, uniform_count: 2048 };
 /// Ray set sizes for the tiny cases.
 pub const TINY_RAYS: RaySetSize = RaySetSize { width: 16, height: 16, uniform_count: 512 };
 
@@ -55,6 +58,8 @@ pub enum Case {
     Mesh(&'static str),
     /// A mesh of the scenes folder with a PLOC tree.
     MeshPloc(&'static str),
+    /// The sphereflake's SAH tree refitted twice as its vertices move ([`breathing`]).
+    Refit,
 }
 
 /// Runs one case on `backend`; panics with a loud report on any mismatch.
@@ -93,6 +98,7 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
                 check_scene(backend, &s, ploc, MESH_RAYS);
             }
         }
+        Case::Refit => check_refit(backend, &generated_scene("sphereflake"), sah, REFIT_RAYS),
     }
 }
 
@@ -160,6 +166,13 @@ pub fn check_scene<B: Trace>(
     build: impl FnOnce(&NamedScene) -> Bvh2,
     size: RaySetSize,
 ) {
+    assert_supports_all(backend);
+    let prepared = Arc::new(PreparedScene::new(&named.scene, build(named), &Method::ALL).expect("prepare"));
+    check_prepared(backend, named, prepared, size);
+}
+
+/// Fails loudly when `backend` does not support every method.
+fn assert_supports_all<B: Trace>(backend: &B) {
     let unsupported: Vec<Method> = Method::ALL.into_iter().filter(|&m| !backend.supports(m)).collect();
     assert!(
         unsupported.is_empty(),
@@ -167,7 +180,10 @@ pub fn check_scene<B: Trace>(
         backend.name(),
         unsupported.iter().map(|m| m.name()).collect::<Vec<_>>()
     );
-    let prepared = Arc::new(PreparedScene::new(&named.scene, build(named), &Method::ALL).expect("prepare"));
+}
+
+/// [`check_scene`] on a scene already prepared (`prepared` is `named`'s).
+pub fn check_prepared<B: Trace>(backend: &B, named: &NamedScene, prepared: Arc<PreparedScene>, size: RaySetSize) {
     let serial = SerialBackend;
     let serial_scene = serial.prepare(prepared.clone()).expect("prepare on the serial backend");
     let scene = backend.prepare(prepared).expect("prepare on the backend");
@@ -206,6 +222,70 @@ pub fn check_scene<B: Trace>(
         Method::ALL.len(),
         backend.name()
     );
+}
+
+/// The refit case: `named`'s tree built where its triangles are, then refitted to where they
+/// moved ([`PreparedScene::refit`]; [`breathing`] at two times, the second refit from the first).
+/// After each refit, every method's hits bit for bit against a scene prepared afresh from the
+/// moved triangles with a tree of their own ([`refit_mismatches`]); after the second, the whole
+/// check of any prepared scene ([`check_prepared`]: every method against its reference and the
+/// serial backend, node visits included).
+pub fn check_refit<B: Trace>(backend: &B, named: &NamedScene, build: impl Fn(&NamedScene) -> Bvh2, size: RaySetSize) {
+    assert_supports_all(backend);
+    let mut prepared = PreparedScene::new(&named.scene, build(named), &Method::ALL).expect("prepare");
+    const PHASES: [f32; 2] = [1.3, 2.9];
+    for phase in PHASES {
+        let moved = breathing(&named.scene, phase).expect("moved scene");
+        let moved = NamedScene::new(format!("{} breathing at {phase}", named.name), moved);
+        prepared.refit(&moved.scene).expect("refit");
+        let refitted = Arc::new(prepared.clone());
+        if phase == PHASES[PHASES.len() - 1] {
+            check_prepared(backend, &moved, refitted.clone(), size);
+        }
+        let fresh = Arc::new(PreparedScene::new(&moved.scene, build(&moved), &Method::ALL).expect("prepare"));
+        let mismatches = refit_mismatches(backend, refitted, fresh, &moved, size);
+        if !mismatches.is_empty() {
+            panic!("REFIT: {}", mismatch_report(&moved.name, backend.name(), 0, &mismatches));
+        }
+        eprintln!("{}: every method's hits on the refitted tree are a fresh tree's on {}", moved.name, backend.name());
+    }
+}
+
+/// Every method's hits on `refitted` (a scene refitted to `named`'s triangles) traced on
+/// `backend`, against the stack method's on `fresh` (the same triangles prepared afresh) on the
+/// serial backend, for both queries on every ray set: the mismatches. Hits do not depend on the
+/// tree (every method finds the same ones on any tree), so any difference is a box the refit left
+/// stale or a triangle it left where it was.
+pub fn refit_mismatches<B: Trace>(
+    backend: &B,
+    refitted: Arc<PreparedScene>,
+    fresh: Arc<PreparedScene>,
+    named: &NamedScene,
+    size: RaySetSize,
+) -> Vec<Mismatch> {
+    let serial = SerialBackend;
+    let fresh = serial.prepare(fresh).expect("prepare on the serial backend");
+    let scene = backend.prepare(refitted).expect("prepare on the backend");
+    let stack = [Method::Bvh2(Bvh2Method::Stack)];
+    let mut trace_closest = |rays: &[Ray]| {
+        let mut hits = vec![Hit::MISS; rays.len()];
+        serial.trace(&fresh, rays, &TraceOptions::new(stack[0]), &mut hits).expect("trace");
+        hits
+    };
+    let versus = format!("{} refitted vs fresh", backend.name());
+    let mut mismatches = Vec::new();
+    for set in ray_sets(&named.scene, size, &mut trace_closest) {
+        let ctx = Context { scene: &named.name, ray_set: set.kind.name(), backend: backend.name() };
+        for query in Query::ALL {
+            let expected = trace_all(&serial, &fresh, &set.rays, &stack, query).expect("trace");
+            let got = trace_all(backend, &scene, &set.rays, &Method::ALL, query).expect("trace");
+            // Each method against the fresh scene's stack method: the same outcome under each name.
+            let expected: Vec<_> =
+                got.iter().map(|o| crate::check::Outcome { method: o.method, ..expected[0].clone() }).collect();
+            mismatches.extend(compare_hits(ctx, &versus, &set.rays, &expected, &got));
+        }
+    }
+    mismatches
 }
 
 /// The loud failure message: how many mismatches, where, and the first ones in full.
@@ -260,6 +340,7 @@ macro_rules! conformance_suite {
             dragon_res2 => Mesh("dragon_vrip_res2.ply.gz"),
             dragon_full => Mesh("dragon_vrip.ply.gz"),
             bunny_with_ploc => MeshPloc("bunny.obj"),
+            refit_sphereflake => Refit,
         );
     };
     (@each $run:expr; $($name:ident => $case:ident $(($file:expr))?,)*) => {

@@ -15,6 +15,8 @@ extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
+#[cfg(feature = "alloc")]
+pub mod all_hits;
 pub mod bvh2;
 pub mod error;
 pub mod geometry;

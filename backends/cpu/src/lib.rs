@@ -6,6 +6,7 @@
 //! path carries no observer at all.
 #![warn(missing_docs)]
 
+mod all_hits;
 mod backend;
 mod bvh2;
 mod chunk;

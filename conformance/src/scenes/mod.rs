@@ -7,7 +7,9 @@
 //! - [`degenerate_stack`]: a tree deeper than 31 levels, so 64-bit keys.
 //! - [`far_from_origin`]: coordinates around 1e5..1e6, where `f32` spacing is coarse.
 //! - [`tiny_cases`]: one to a handful of triangles, for corner cases.
+//! - [`breathing`]: any of them with its vertices moved, for the refit checks.
 
+mod breathing;
 mod far;
 mod grid;
 pub(crate) mod icosphere;
@@ -16,6 +18,7 @@ mod sphereflake;
 mod stack;
 mod tiny;
 
+pub use breathing::breathing;
 pub use far::{far_from_origin, FAR_CENTER};
 pub use grid::shared_edge_grid;
 pub use soup::triangle_soup;

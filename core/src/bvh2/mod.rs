@@ -1,6 +1,8 @@
 //! Binary bounding volume hierarchies: the canonical tree, its builders and its node layouts.
 //!
 //! - [`Bvh2`]: the canonical tree, the single source of truth (node identity = index, pre-order).
+//! - [`Bvh2::refit`]: new boxes for moved triangles, the topology (and every table made from it)
+//!   kept.
 //! - [`SahBuilder`]: a binned SAH builder (needs `alloc`); [`SahConfig::tree_cost`] prices a
 //!   finished tree, whoever built it.
 //! - [`BinaryLayout`]: the Aila-Laine layout (both child boxes in the parent, leaf triangle arrays
@@ -18,6 +20,8 @@ pub use node::{BinaryNode, LeafWord, NodeRef};
 mod cost;
 #[cfg(feature = "alloc")]
 mod layout;
+#[cfg(feature = "alloc")]
+mod refit;
 #[cfg(feature = "alloc")]
 mod sah;
 #[cfg(feature = "alloc")]

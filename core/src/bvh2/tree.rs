@@ -166,6 +166,12 @@ impl Bvh2 {
         Ok(())
     }
 
+    /// The nodes to write and the primitive order to read, for [`Bvh2::refit`], which changes
+    /// boxes only.
+    pub(super) fn nodes_and_order_mut(&mut self) -> (&mut [Bvh2Node], &[u32]) {
+        (&mut self.nodes, &self.prim_order)
+    }
+
     /// Nodes in canonical order.
     pub fn nodes(&self) -> &[Bvh2Node] {
         &self.nodes

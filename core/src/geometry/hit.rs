@@ -51,6 +51,13 @@ impl Hit {
         t < self.t || (t == self.t && prim < self.prim)
     }
 
+    /// The order of the closest-hit rule ([`Hit::is_beaten_by`]): the nearer first, at an equal
+    /// `t` (`-0.0` equals `0.0`) the lower primitive id. A NaN `t` (a refused hit) is ordered
+    /// as equal to everything by `t`, so by its id.
+    pub fn order(&self, other: &Hit) -> core::cmp::Ordering {
+        self.t.partial_cmp(&other.t).unwrap_or(core::cmp::Ordering::Equal).then(self.prim.cmp(&other.prim))
+    }
+
     /// Whether two hits are identical bit for bit in `t` and `prim` (the conformance criterion).
     pub fn same_as(&self, other: &Hit) -> bool {
         self.prim == other.prim && self.t.to_bits() == other.t.to_bits()

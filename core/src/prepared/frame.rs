@@ -78,6 +78,12 @@ impl FramedRays<'_> {
         &self.rays
     }
 
+    /// Whether any ray was changed (scaled, moved, refused or answered without tracing): where
+    /// none was, the rays are the caller's own and the hits need nothing.
+    pub fn changed(&self) -> bool {
+        !self.fixes.is_empty()
+    }
+
     /// Puts the hits back in the caller's frame (moved rays' `t`, refused rays' [`Hit::REFUSED`])
     /// and returns how many rays were refused.
     pub fn finish(&self, hits: &mut [Hit]) -> usize {

@@ -5,6 +5,7 @@ mod enumeration;
 mod frame;
 pub mod normalize;
 mod parts;
+mod refit;
 
 pub use frame::{FramedRays, RayCheck, FAR_FACTOR, FAR_LIMIT};
 pub use parts::Part;

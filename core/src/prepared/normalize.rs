@@ -73,24 +73,33 @@ fn scale_v(v: Vec3, k: i32) -> Vec3 {
     Vec3::new(scale_pow2(v.x, -k), scale_pow2(v.y, -k), scale_pow2(v.z, -k))
 }
 
-/// `scene` and `bvh` scaled by `2^-k` for the exponent of [`exponent_for`], and `k`; unchanged
-/// with `k = 0` when no scaling is needed, or when some coordinate would not scale exactly (a
-/// scene spanning more than the `f32` exponent range: it is then traced as given).
-pub fn normalize(scene: &Scene, bvh: Bvh2) -> Result<(Option<Scene>, Bvh2, i32), Error> {
+/// `scene` scaled by `2^-k` for the exponent of [`exponent_for`], and `k`; `None` with `k = 0`
+/// when no scaling is needed, or when some coordinate would not scale exactly (a scene spanning
+/// more than the `f32` exponent range: it is then traced as given).
+pub fn scaled_scene(scene: &Scene) -> Result<(Option<Scene>, i32), Error> {
     let k = exponent_for(scene.bounds().max_abs());
     let lossless =
         k != 0 && scene.triangles().iter().all(|t| t.v.iter().all(|v| v.to_array().iter().all(|&x| exact(x, k))));
     if !lossless {
-        return Ok((None, bvh, 0));
+        return Ok((None, 0));
     }
     let tris: Vec<Triangle> = scene.triangles().iter().map(|t| Triangle { v: t.v.map(|v| scale_v(v, k)) }).collect();
+    Ok((Some(Scene::new(tris)?), k))
+}
+
+/// `scene` and `bvh` scaled alike by [`scaled_scene`]'s power of two, and its exponent.
+pub fn normalize(scene: &Scene, bvh: Bvh2) -> Result<(Option<Scene>, Bvh2, i32), Error> {
+    let (scaled, k) = scaled_scene(scene)?;
+    if scaled.is_none() {
+        return Ok((None, bvh, 0));
+    }
     let nodes: Vec<Bvh2Node> = bvh
         .nodes()
         .iter()
         .map(|n| Bvh2Node { bounds: Aabb::new(scale_v(n.bounds.min, k), scale_v(n.bounds.max, k)), kind: n.kind })
         .collect();
-    let scaled = Bvh2::from_nodes(&nodes, 0, bvh.prim_order().to_vec())?;
-    Ok((Some(Scene::new(tris)?), scaled, k))
+    let scaled_bvh = Bvh2::from_nodes(&nodes, 0, bvh.prim_order().to_vec())?;
+    Ok((scaled, scaled_bvh, k))
 }
 
 #[cfg(test)]

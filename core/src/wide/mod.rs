@@ -3,7 +3,7 @@
 //! - [`WideNode`]: `W` child boxes as a structure of arrays, child references and leaf ranges,
 //!   `Pod`, one byte layout for the CPU and the WGSL kernels;
 //! - [`WideBvh`]: the collapse (Guthe's pull-up, or every second level removed), keeping every
-//!   binary leaf whole (needs `alloc`);
+//!   binary leaf whole (needs `alloc`), and refitted with it after the vertices move ([`WideBvh::refit`]);
 //! - [`ChildKernel`]: testing and ordering a node's children, by the plain [`ReferenceKernel`] or
 //!   the [`FastKernel`] (SIMD box tests, the sorting network of [`network`]) that must equal it;
 //! - [`LeafBlock`]: four of a leaf's triangles and their primitive ids, as the CPU reads them;
@@ -29,6 +29,8 @@ pub mod packet;
 mod prefetch;
 #[cfg(feature = "alloc")]
 pub mod ray_stream;
+#[cfg(feature = "alloc")]
+mod refit;
 pub mod trail;
 pub mod traverse;
 #[cfg(feature = "alloc")]

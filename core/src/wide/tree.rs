@@ -83,6 +83,16 @@ impl<const W: usize> WideBvh<W> {
         Ok(out)
     }
 
+    /// The nodes to write, with the canonical ids of nodes and leaves, for [`WideBvh::refit`].
+    pub(super) fn boxes_mut(&mut self) -> (&mut [WideNode<W>], &[u32], &[u32]) {
+        (&mut self.nodes, &self.node_ids, &self.leaf_ids)
+    }
+
+    /// The triangles and blocks to write, with the primitive ids, for [`WideBvh::refit`].
+    pub(super) fn triangles_mut(&mut self) -> (&mut [Triangle], &[u32], &mut [LeafBlock]) {
+        (&mut self.triangles, &self.prims, &mut self.blocks)
+    }
+
     /// The nodes, root first, in depth-first order.
     pub fn nodes(&self) -> &[WideNode<W>] {
         &self.nodes

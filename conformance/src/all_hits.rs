@@ -1,0 +1,142 @@
+//! The check of all-hits lists ([`raytrail_core::all_hits`]), twice over:
+//! - **bit for bit** against a brute force over every triangle with the same watertight test,
+//!   the ray framed as the backends frame it: the walk must visit every leaf that holds a hit it
+//!   keeps, report each triangle once, and order, merge and cut as the options say;
+//! - **against the exact reference**, triangle by triangle ([`exact_hit`]): every triangle the
+//!   exact ray hits must be in the list and every listed one must be hit, at a `t` within the
+//!   [`Tolerance`], except where the ray passes within the tolerance of the triangle's boundary
+//!   (where a float test may decide either way: the neighbour across a shared edge, or both) or
+//!   the hit lies within it of the interval's ends.
+//!
+//! The exact check goes over every triangle for every ray: it is for small scenes.
+
+use crate::exact::filter::{filter, margin, Filtered};
+use crate::exact::triangle::exact_hit;
+use crate::exact::Tolerance;
+use raytrail_core::all_hits::{all_hits_tree, AllHits, AllHitsOptions};
+use raytrail_core::geometry::Triangle;
+use raytrail_core::intersect::{TriangleTest, Watertight};
+use raytrail_core::prepared::PreparedScene;
+use raytrail_core::traverse::begin_slab;
+use raytrail_core::wide::WideTree;
+use raytrail_core::{Hit, Ray};
+
+/// The triangles of `prepared` by primitive id, in its frame (scaled as it was prepared), from
+/// the wide tree the all-hits walk reads.
+fn framed_triangles(prepared: &PreparedScene) -> Vec<(u32, Triangle)> {
+    let (tree, _) = all_hits_tree(prepared).expect("a scene with a wide tree");
+    let (tris, prims) = match tree {
+        WideTree::Four(t) => (t.triangles(), t.prims()),
+        WideTree::Eight(t) => (t.triangles(), t.prims()),
+    };
+    let mut out: Vec<(u32, Triangle)> =
+        prims.iter().zip(tris).filter(|(&p, _)| p != u32::MAX).map(|(&p, &t)| (p, t)).collect();
+    out.sort_by_key(|(p, _)| *p);
+    out
+}
+
+/// What the lists of `rays` must be in `prepared` under `options`, by brute force: per ray, the
+/// hits and whether the list is cut.
+pub fn brute_force(prepared: &PreparedScene, rays: &[Ray], options: &AllHitsOptions) -> Vec<(Vec<Hit>, bool)> {
+    let tris = framed_triangles(prepared);
+    rays.iter()
+        .map(|ray| {
+            let framed = prepared.frame_rays(std::slice::from_ref(ray));
+            let mut probe = [Hit::MISS];
+            if framed.finish(&mut probe) == 1 {
+                return (vec![Hit::REFUSED], false);
+            }
+            let r = framed.rays()[0];
+            let mut hits = Vec::new();
+            if begin_slab(&r, prepared.scene_scale()).is_some() {
+                let per_ray = Watertight::prepare(&r);
+                for (prim, t) in &tris {
+                    let [a, b, c] = t.v.map(|v| v.to_array());
+                    if let Some(h) = Watertight::intersect_in_place(&per_ray, [&a, &b, &c], r.tmin, r.tmax) {
+                        hits.push(Hit { t: h.t, prim: *prim, u: h.u, v: h.v });
+                    }
+                }
+            }
+            // Ordered, merged and cut in the scene's frame, where the closest hit is decided; then
+            // each `t` back in the caller's.
+            hits.sort_by(Hit::order);
+            if options.merge_equal_t {
+                hits.dedup_by(|later, first| later.t == first.t);
+            }
+            let cut = hits.len() > options.max_hits;
+            hits.truncate(options.max_hits);
+            for hit in &mut hits {
+                framed.finish(std::slice::from_mut(hit));
+            }
+            (hits, cut)
+        })
+        .collect()
+}
+
+/// Every ray whose list in `got` differs from [`brute_force`]'s, bit for bit in `t`, `prim`,
+/// `u` and `v`, or in its truncation flag: `(ray index, what differs)`.
+pub fn brute_force_mismatches(
+    prepared: &PreparedScene,
+    rays: &[Ray],
+    options: &AllHitsOptions,
+    got: &AllHits,
+) -> Vec<(usize, String)> {
+    let bits = |h: &Hit| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits());
+    let mut out = Vec::new();
+    if got.len() != rays.len() {
+        out.push((0, format!("{} lists for {} rays", got.len(), rays.len())));
+    }
+    for (i, (want, cut)) in brute_force(prepared, rays, options).into_iter().enumerate() {
+        let list = got.ray(i).unwrap_or(&[]);
+        if list.len() != want.len() || !list.iter().zip(&want).all(|(a, b)| bits(a) == bits(b)) {
+            let show = |l: &[Hit]| l.iter().map(|h| format!("({}, {})", h.prim, h.t)).collect::<Vec<_>>().join(" ");
+            out.push((i, format!("ray {:?}: expected [{}], got [{}]", rays[i], show(&want), show(list))));
+        } else if got.is_truncated(i) != cut {
+            out.push((i, format!("truncated: expected {cut}, got {}", got.is_truncated(i))));
+        }
+    }
+    out
+}
+
+/// Every disagreement of the complete lists of `got` (rays neither truncated nor refused) with
+/// the exact reference over `triangles` (the scene as given, by primitive id), for a scene whose
+/// largest coordinate magnitude is `scene_scale`: `(ray index, what disagrees)`. Lists made with
+/// [`AllHitsOptions::merge_equal_t`] are not for this check (a merged neighbour is no error).
+pub fn exact_mismatches(triangles: &[Triangle], scene_scale: f32, rays: &[Ray], got: &AllHits) -> Vec<(usize, String)> {
+    let tol = Tolerance::for_scene(scene_scale);
+    let mut out = Vec::new();
+    for (i, ray) in rays.iter().enumerate() {
+        let list = got.ray(i).unwrap_or(&[]);
+        if got.is_truncated(i) || list.iter().any(Hit::is_refused) || !ray.is_traceable() {
+            continue;
+        }
+        for (prim, tri) in triangles.iter().enumerate() {
+            let exact = match filter(ray, tri) {
+                Filtered::Miss => None,
+                Filtered::Hit { .. } | Filtered::Unsure { .. } => exact_hit(ray, tri).map(|t| t.to_f64()),
+            };
+            let listed = list.iter().find(|h| h.prim == prim as u32).map(|h| f64::from(h.t));
+            let near_edge = margin(ray, tri).is_none_or(|m| m.abs() <= tol.delta);
+            let near_end = |t: f64| {
+                let w = tol.t(ray, tri, t);
+                (t - f64::from(ray.tmin)).abs() <= w || (t - f64::from(ray.tmax)).abs() <= w
+            };
+            let problem = match (exact, listed) {
+                (None, None) => None,
+                (Some(e), Some(f)) => {
+                    (f - e).abs().gt(&tol.t(ray, tri, e)).then(|| format!("triangle {prim}: t {f}, exactly {e}"))
+                }
+                (Some(e), None) => {
+                    (!near_edge && !near_end(e)).then(|| format!("triangle {prim} is hit at t {e} but not listed"))
+                }
+                (None, Some(f)) => {
+                    (!near_edge && !near_end(f)).then(|| format!("triangle {prim} is listed at t {f} but not hit"))
+                }
+            };
+            if let Some(p) = problem {
+                out.push((i, format!("ray {ray:?}: {p}")));
+            }
+        }
+    }
+    out
+}
