@@ -29,6 +29,9 @@ pub enum Error {
     /// a direction too short to trace reliably), so it was refused rather than answered wrongly;
     /// a batch answers such rays with [`Hit::REFUSED`](raytrail_core::Hit::REFUSED) instead.
     RefusedRay,
+    /// A nearest-point search radius that is NaN or negative ([`crate::Tracer::nearest_points`];
+    /// `f32::INFINITY` searches the whole mesh).
+    InvalidRadius(f32),
     /// A thread pool for [`crate::TracerBuilder::threads`] could not be made.
     #[cfg(feature = "cpu")]
     ThreadPool(raytrail_cpu::ThreadPoolBuildError),
@@ -46,6 +49,9 @@ impl fmt::Display for Error {
                  direction, a NaN bound or tmin > tmax"
             ),
             Error::RefusedRay => f.write_str("the ray lies outside the numeric range the methods answer exactly"),
+            Error::InvalidRadius(r) => {
+                write!(f, "search radius {r}: must be zero or more (f32::INFINITY for no limit)")
+            }
             #[cfg(feature = "cpu")]
             Error::ThreadPool(e) => write!(f, "cannot make the thread pool: {e}"),
         }
@@ -60,7 +66,7 @@ impl std::error::Error for Error {
             Error::Mesh(e) => Some(e),
             #[cfg(feature = "cpu")]
             Error::ThreadPool(e) => Some(e),
-            Error::UntraceableRays { .. } | Error::RefusedRay => None,
+            Error::UntraceableRays { .. } | Error::RefusedRay | Error::InvalidRadius(_) => None,
         }
     }
 }

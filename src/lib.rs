@@ -101,6 +101,7 @@ pub use raytrail_build::Builder;
 pub use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 pub use raytrail_core::glam::Vec3;
 pub use raytrail_core::method::{Method, Query};
+pub use raytrail_core::nearest::NearestPoint;
 pub use raytrail_core::{Hit, Ray};
 
 /// Loads a mesh file (`.obj`, `.ply`, `.off`, `.stl`, `.gltf`, `.glb`, any of them gzipped) with

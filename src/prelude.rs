@@ -8,6 +8,7 @@ pub use crate::{Tracer, TracerBuilder};
 pub use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 pub use raytrail_core::glam::Vec3;
 pub use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query, StreamMethod, WideMethod};
+pub use raytrail_core::nearest::NearestPoint;
 pub use raytrail_core::prepared::PreparedScene;
 pub use raytrail_core::scene::{Mesh, Scene};
 pub use raytrail_core::trace::{Record, Report, Trace, TraceOptions};

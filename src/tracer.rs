@@ -12,6 +12,7 @@ use crate::analysis::sample::choose_among;
 use crate::{Builder, Error};
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::method::{Method, Query, WideMethod};
+use raytrail_core::nearest::NearestPoint;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::scene::{Mesh, Scene};
 use raytrail_core::trace::{Report, Trace, TraceOptions};
@@ -244,6 +245,29 @@ impl Tracer {
             }
         }
         Ok(self.backend.all_hits(&self.scene, rays, options)?)
+    }
+
+    /// The point of the mesh nearest to each of `points` within distance `radius` (inclusive;
+    /// `f32::INFINITY` for the whole mesh): its triangle, barycentric weights, position and
+    /// distance, or `None` where no triangle comes that close (and for a point that is not
+    /// finite). Ties go to the lower primitive id. [`Error::InvalidRadius`] for a NaN or negative
+    /// radius; the tree is the one [`Tracer::intersect_all`] walks.
+    ///
+    /// ```
+    /// use raytrail::Tracer;
+    /// # fn main() -> Result<(), raytrail::Error> {
+    /// let tracer = Tracer::new(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]])?;
+    /// let near = tracer.nearest_points(&[[0.25, 0.25, 2.0], [5.0, 0.0, 0.0]], 3.0)?;
+    /// assert_eq!(near[0].map(|n| (n.prim, n.point, n.distance)), Some((0, [0.25, 0.25, 0.0], 2.0)));
+    /// assert_eq!(near[1], None, "4 from the triangle, beyond the radius");
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn nearest_points(&self, points: &[[f32; 3]], radius: f32) -> Result<Vec<Option<NearestPoint>>, Error> {
+        if radius.is_nan() || radius < 0.0 {
+            return Err(Error::InvalidRadius(radius));
+        }
+        Ok(self.backend.nearest_points(&self.scene, points, radius)?)
     }
 
     /// Moves the scene's triangles to new vertex positions (the same triangles by index, as an

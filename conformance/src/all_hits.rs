@@ -13,7 +13,7 @@
 use crate::exact::filter::{filter, margin, Filtered};
 use crate::exact::triangle::exact_hit;
 use crate::exact::Tolerance;
-use raytrail_core::all_hits::{all_hits_tree, AllHits, AllHitsOptions};
+use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::geometry::Triangle;
 use raytrail_core::intersect::{TriangleTest, Watertight};
 use raytrail_core::prepared::PreparedScene;
@@ -24,7 +24,7 @@ use raytrail_core::{Hit, Ray};
 /// The triangles of `prepared` by primitive id, in its frame (scaled as it was prepared), from
 /// the wide tree the all-hits walk reads.
 fn framed_triangles(prepared: &PreparedScene) -> Vec<(u32, Triangle)> {
-    let (tree, _) = all_hits_tree(prepared).expect("a scene with a wide tree");
+    let (tree, _) = prepared.query_tree().expect("a scene with a wide tree");
     let (tris, prims) = match tree {
         WideTree::Four(t) => (t.triangles(), t.prims()),
         WideTree::Eight(t) => (t.triangles(), t.prims()),

@@ -25,6 +25,8 @@ pub mod intersect;
 pub mod kd;
 pub mod key;
 pub mod method;
+#[cfg(feature = "alloc")]
+pub mod nearest;
 pub mod observe;
 #[cfg(feature = "alloc")]
 pub mod prepared;

@@ -8,7 +8,9 @@
 
 - :class:`Scene` builds the tree once from vertices and faces (:func:`load` from a mesh file);
   :meth:`Scene.intersect` returns :class:`Hits` ``(t, prim, u, v)``, :meth:`Scene.occluded` a
-  bool per ray. Both release the GIL and trace on all cores.
+  bool per ray, :meth:`Scene.intersect_all` every hit along each ray (:class:`AllHits`), :meth:`Scene.nearest`
+  the nearest point on the mesh to each query point (:class:`Nearest`). All release the GIL and
+  run on all cores.
 - :mod:`raytrail.trimesh`: ``RayMeshIntersector``, a drop-in for ``mesh.ray`` in trimesh.
 - :mod:`raytrail.dask`: ``intersect`` / ``occluded`` over dask arrays chunked by rows, on
   dask.distributed or any other scheduler.
@@ -18,9 +20,9 @@ scene to answer exactly (``t`` NaN). See the package README for the conventions 
 """
 
 from ._raytrail import METHODS, REFUSED, Scene, __version__, load
-from ._hits import Hits
+from ._hits import AllHits, Hits, Nearest
 
-__all__ = ["Scene", "Hits", "load", "METHODS", "REFUSED", "__version__", "trimesh", "dask"]
+__all__ = ["Scene", "Hits", "AllHits", "Nearest", "load", "METHODS", "REFUSED", "__version__", "trimesh", "dask"]
 
 
 def __getattr__(name):

@@ -1,4 +1,5 @@
-"""The result type of :meth:`raytrail.Scene.intersect`."""
+"""The result types of :meth:`raytrail.Scene.intersect`, :meth:`raytrail.Scene.intersect_all` and
+:meth:`raytrail.Scene.nearest`."""
 
 from typing import NamedTuple
 
@@ -18,6 +19,44 @@ class Hits(NamedTuple):
     """
 
     t: np.ndarray
+    prim: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+
+
+class AllHits(NamedTuple):
+    """Every hit of each of N rays, as five arrays of length H (the hits of all rays, ray by ray,
+    each ray's in order of ``t``) and one of length N (unpack as
+    ``ray, t, prim, u, v, truncated = scene.intersect_all(...)``).
+
+    - ``ray`` (int64): the index of the ray each hit belongs to (trimesh's ``index_ray``),
+      non-decreasing; ``np.bincount(ray, minlength=N)`` counts each ray's hits.
+    - ``t``, ``prim``, ``u``, ``v``: as in :class:`Hits`, one entry per hit (no misses). A ray
+      refused as too far from the scene has one entry, ``prim == raytrail.REFUSED``.
+    - ``truncated`` (bool, length N): the ray had more hits than ``max_hits`` (its nearest are
+      listed).
+    """
+
+    ray: np.ndarray
+    t: np.ndarray
+    prim: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    truncated: np.ndarray
+
+
+class Nearest(NamedTuple):
+    """The point of the mesh nearest to each of N query points (unpack as
+    ``point, distance, prim, u, v = scene.nearest(points)``).
+
+    - ``point`` (float32, (N, 3)): the nearest point; NaN where none is within the radius.
+    - ``distance`` (float32): its distance from the query point; ``inf`` where none.
+    - ``prim`` (int64): the face it lies on; ``-1`` where none.
+    - ``u``, ``v`` (float32): barycentric weights of the face's second and third vertex at it.
+    """
+
+    point: np.ndarray
+    distance: np.ndarray
     prim: np.ndarray
     u: np.ndarray
     v: np.ndarray

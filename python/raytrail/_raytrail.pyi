@@ -6,7 +6,7 @@ from typing import Optional, Tuple, Union
 import numpy as np
 import numpy.typing as npt
 
-from ._hits import Hits
+from ._hits import AllHits, Hits, Nearest
 
 __version__: str
 #: "auto" and every method name the tracer knows (Scene.intersect's `method`).
@@ -38,6 +38,19 @@ class Scene:
         method: str = "auto",
     ) -> npt.NDArray[np.bool_]:
         """Whether anything blocks each ray within [tmin, tmax]."""
+    def intersect_all(
+        self,
+        origins: npt.ArrayLike,
+        directions: Optional[npt.ArrayLike] = None,
+        tmin: _Bound = None,
+        tmax: _Bound = None,
+        *,
+        max_hits: Optional[int] = None,
+        merge_equal_t: bool = False,
+    ) -> AllHits:
+        """Every hit along each ray, in order of t: AllHits(ray, t, prim, u, v, truncated)."""
+    def nearest(self, points: npt.ArrayLike, radius: float = ...) -> Nearest:
+        """The nearest point on the mesh to each point: Nearest(point, distance, prim, u, v)."""
     @property
     def vertices(self) -> npt.NDArray[np.float32]: ...
     @property

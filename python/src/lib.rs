@@ -16,7 +16,7 @@ use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyTypeErr
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyTuple;
-use raytrail::{Hit, Method, Ray, Tracer};
+use raytrail::{AllHits, AllHitsOptions, Hit, Method, Ray, Tracer};
 use std::cell::Cell;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -646,6 +646,16 @@ fn hits_type(py: Python<'_>) -> PyResult<&Bound<'_, PyAny>> {
     Ok(HITS.get_or_try_init(py, || py.import("raytrail._hits")?.getattr("Hits").map(Bound::unbind))?.bind(py))
 }
 
+fn nearest_type(py: Python<'_>) -> PyResult<&Bound<'_, PyAny>> {
+    static NEAREST: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    Ok(NEAREST.get_or_try_init(py, || py.import("raytrail._hits")?.getattr("Nearest").map(Bound::unbind))?.bind(py))
+}
+
+fn all_hits_type(py: Python<'_>) -> PyResult<&Bound<'_, PyAny>> {
+    static ALL_HITS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    Ok(ALL_HITS.get_or_try_init(py, || py.import("raytrail._hits")?.getattr("AllHits").map(Bound::unbind))?.bind(py))
+}
+
 /// A miss's `prim` is -1, a refused ray's [`REFUSED`], a hit's the triangle's index.
 #[inline(always)]
 fn prim_id(prim: u32) -> i64 {
@@ -772,6 +782,125 @@ impl Scene {
             )));
         }
         Ok(out.into_pyarray(py))
+    }
+
+    /// intersect_all(origins, directions=None, tmin=None, tmax=None, *, max_hits=None, merge_equal_t=False)
+    ///
+    /// Every hit of each ray within ``[tmin, tmax]``, as ``AllHits(ray, t, prim, u, v,
+    /// truncated)``: the hits of all rays one ray after another, each ray's in order of ``t``
+    /// (ties by face index), each face at most once. ``ray`` gives the ray of each hit (as
+    /// trimesh's ``index_ray``), ``truncated`` (length N) marks rays with more than ``max_hits``
+    /// hits, of which the nearest are listed. A ray through an edge two faces share meets both,
+    /// at one ``t``; ``merge_equal_t=True`` keeps only the lower face index of hits at one ``t``.
+    /// Rays are given as for ``intersect``; the first hit of each ray is ``intersect``'s.
+    #[pyo3(signature = (origins, directions=None, tmin=None, tmax=None, *, max_hits=None, merge_equal_t=false))]
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn intersect_all<'py>(
+        &self,
+        py: Python<'py>,
+        origins: &Bound<'py, PyAny>,
+        directions: Option<&Bound<'py, PyAny>>,
+        tmin: Option<&Bound<'py, PyAny>>,
+        tmax: Option<&Bound<'py, PyAny>>,
+        max_hits: Option<usize>,
+        merge_equal_t: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let args = RayArgs::new(origins, directions, tmin, tmax)?;
+        let views = RayViews::new(&args)?;
+        let options = AllHitsOptions { max_hits: max_hits.unwrap_or(usize::MAX), merge_equal_t };
+        let tracer = self.auto.clone();
+        let n = views.len();
+        let (ray, t, prim, u, v, truncated) = py
+            .detach(|| -> Result<_, raytrail::Error> {
+                let rays = views.rays();
+                let lists = if n > 0 { tracer.intersect_all(rays.as_slice(), &options)? } else { AllHits::default() };
+                let h = lists.hits().len();
+                let (mut ray, mut t, mut prim, mut u, mut v) = (
+                    Vec::with_capacity(h),
+                    Vec::with_capacity(h),
+                    Vec::with_capacity(h),
+                    Vec::with_capacity(h),
+                    Vec::with_capacity(h),
+                );
+                for (i, list) in lists.iter().enumerate() {
+                    for hit in list {
+                        ray.push(i as i64);
+                        t.push(hit.t);
+                        prim.push(prim_id(hit.prim));
+                        u.push(hit.u);
+                        v.push(hit.v);
+                    }
+                }
+                let truncated: Vec<bool> = (0..n).map(|i| lists.is_truncated(i)).collect();
+                Ok((ray, t, prim, u, v, truncated))
+            })
+            .map_err(py_err)?;
+        all_hits_type(py)?.call1((
+            ray.into_pyarray(py),
+            t.into_pyarray(py),
+            prim.into_pyarray(py),
+            u.into_pyarray(py),
+            v.into_pyarray(py),
+            truncated.into_pyarray(py),
+        ))
+    }
+
+    /// nearest(points, radius=inf)
+    ///
+    /// The point of the mesh nearest to each of N query points (an (N, 3) array of any real
+    /// dtype), within distance ``radius`` (inclusive), as ``Nearest(point, distance, prim, u, v)``:
+    /// ``point`` (N, 3) float32, ``distance`` float32, ``prim`` int64 (the face), ``u``, ``v``
+    /// float32 (barycentric weights of the face's second and third vertex). Where no face comes
+    /// within the radius, or for a point that is not finite: ``prim`` -1, ``distance`` inf,
+    /// ``point`` NaN, ``u`` and ``v`` 0. Ties go to the lower face index. (trimesh's
+    /// ``closest_point`` gives ``point, distance, prim`` in that order too.)
+    #[pyo3(signature = (points, radius=f32::INFINITY))]
+    fn nearest<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>, radius: f32) -> PyResult<Bound<'py, PyAny>> {
+        let r = Reals::new(points, "points")?;
+        if !matches!(r.shape(), [_, 3]) {
+            return Err(value_error(format!("points: expected shape (N, 3), got {}", shape_str(r.shape()))));
+        }
+        let rows = r.rows(3, "points")?;
+        let pts: Vec<[f32; 3]> = (0..rows.len()).map(|i| [rows.get(i, 0), rows.get(i, 1), rows.get(i, 2)]).collect();
+        if radius.is_nan() || radius < 0.0 {
+            return Err(value_error(format!("radius: {radius}; must be zero or more (inf for no limit)")));
+        }
+        let tracer = self.auto.clone();
+        let found = py.detach(|| tracer.nearest_points(&pts, radius)).map_err(py_err)?;
+        let n = found.len();
+        let (mut point, mut distance, mut prim, mut u, mut v) = (
+            Vec::with_capacity(3 * n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
+        for f in &found {
+            match f {
+                Some(f) => {
+                    point.extend_from_slice(&f.point);
+                    distance.push(f.distance);
+                    prim.push(i64::from(f.prim));
+                    u.push(f.u);
+                    v.push(f.v);
+                }
+                None => {
+                    point.extend_from_slice(&[f32::NAN; 3]);
+                    distance.push(f32::INFINITY);
+                    prim.push(-1);
+                    u.push(0.0);
+                    v.push(0.0);
+                }
+            }
+        }
+        let point = point.into_pyarray(py).reshape([n, 3])?;
+        nearest_type(py)?.call1((
+            point,
+            distance.into_pyarray(py),
+            prim.into_pyarray(py),
+            u.into_pyarray(py),
+            v.into_pyarray(py),
+        ))
     }
 
     /// The vertices, (n, 3) float32 (a copy).

@@ -351,3 +351,51 @@ def test_package_surface():
     assert raytrail.trimesh.RayMeshIntersector.__doc__
     assert (pathlib.Path(raytrail.__file__).parent / "py.typed").exists()
     assert (pathlib.Path(raytrail.__file__).parent / "__init__.pyi").exists()
+
+
+def test_intersect_all_lists_every_hit_in_order_and_the_first_is_intersect_s():
+    # Two parallel triangles, at z = 0 and z = -1; one ray through both, one through neither.
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, -1], [1, 0, -1], [0, 1, -1]], dtype=np.float32)
+    scene = raytrail.Scene(v, [[3, 4, 5], [0, 1, 2]])
+    o = np.array([[0.25, 0.25, 1.0], [2.0, 2.0, 1.0], [0.25, 0.25, 1.0]])
+    d = np.array([[0.0, 0.0, -1.0]] * 3)
+    ray, t, prim, u, vv, truncated = scene.intersect_all(o, d)
+    assert ray.dtype == np.int64 and prim.dtype == np.int64 and t.dtype == np.float32 and truncated.dtype == np.bool_
+    assert ray.tolist() == [0, 0, 2, 2] and prim.tolist() == [1, 0, 1, 0] and t.tolist() == [1.0, 2.0, 1.0, 2.0]
+    assert truncated.tolist() == [False, False, False]
+    assert np.bincount(ray, minlength=3).tolist() == [2, 0, 2]
+    first = scene.intersect(o, d)
+    assert first.prim[0] == prim[0] and first.t[0] == t[0]
+    cut = scene.intersect_all(o, d, max_hits=1)
+    assert cut.prim.tolist() == [1, 1] and cut.truncated.tolist() == [True, False, True]
+    short = scene.intersect_all(o, d, tmax=1.5)
+    assert short.prim.tolist() == [1, 1]
+    none = scene.intersect_all(np.empty((0, 3)), np.empty((0, 3)))
+    assert len(none.ray) == 0 and len(none.truncated) == 0
+
+
+def test_intersect_all_at_a_shared_edge_meets_both_faces_or_one_merged():
+    # A unit square of two triangles sharing the diagonal from (0, 0) to (1, 1).
+    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float32)
+    scene = raytrail.Scene(v, [[0, 1, 2], [0, 2, 3]])
+    o, d = np.array([[0.5, 0.5, 1.0]]), np.array([[0.0, 0.0, -1.0]])
+    both = scene.intersect_all(o, d)
+    assert both.prim.tolist() == [0, 1] and both.t.tolist() == [1.0, 1.0]
+    merged = scene.intersect_all(o, d, merge_equal_t=True)
+    assert merged.prim.tolist() == [0]
+
+
+def test_nearest_gives_point_distance_and_face_within_the_radius():
+    scene = raytrail.Scene(TRI_V, TRI_F)
+    pts = np.array([[0.25, 0.25, 2.0], [5.0, 0.0, 0.0], [-1.0, -1.0, 0.0]])
+    point, distance, prim, u, v = scene.nearest(pts)
+    assert point.shape == (3, 3) and point.dtype == np.float32 and prim.dtype == np.int64
+    assert point[0].tolist() == [0.25, 0.25, 0.0] and distance[0] == 2.0 and prim[0] == 0
+    assert u[0] == 0.25 and v[0] == 0.25
+    assert point[2].tolist() == [0.0, 0.0, 0.0] and np.isclose(distance[2], np.sqrt(2.0))
+    near = scene.nearest(pts, radius=3.0)
+    assert near.prim.tolist() == [0, -1, 0] and near.distance[1] == np.inf and np.isnan(near.point[1]).all()
+    with pytest.raises(ValueError, match="radius"):
+        scene.nearest(pts, radius=-1.0)
+    with pytest.raises(ValueError, match="points"):
+        scene.nearest(np.zeros((2, 2)))

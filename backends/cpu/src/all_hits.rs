@@ -17,7 +17,7 @@ impl CpuBackend {
     pub fn all_hits(&self, scene: &CpuScene, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
         let prepared = &scene.0;
         // Fails here, once, for a scene without a wide tree.
-        raytrail_core::all_hits::all_hits_tree(prepared)?;
+        prepared.query_tree()?;
         let parts: Vec<Result<AllHits, Error>> =
             self.install(|| rays.par_chunks(CHUNK).map(|chunk| AllHits::trace(prepared, chunk, options)).collect());
         let mut out = AllHits::default();

@@ -11,6 +11,7 @@ mod backend;
 mod bvh2;
 mod chunk;
 mod kd;
+mod nearest;
 mod record;
 mod stream;
 #[cfg(all(test, target_arch = "x86_64"))]

@@ -13,6 +13,7 @@
 mod adversarial;
 mod diffuse;
 mod inside;
+mod points;
 mod primary;
 mod shadow;
 mod uniform;
@@ -20,6 +21,7 @@ mod uniform;
 pub use adversarial::adversarial;
 pub use diffuse::diffuse;
 pub use inside::up_axis;
+pub use points::query_points;
 pub use primary::{morton_encode, morton_order, primary, primary_from, Camera};
 pub use shadow::shadow;
 pub use uniform::uniform_random;

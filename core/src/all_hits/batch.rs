@@ -2,7 +2,7 @@
 //! `list_intersections` and trimesh's `intersects_location` return them): ray `i`'s hits are
 //! `hits[offsets[i]..offsets[i + 1]]`.
 
-use super::walk::{all_hits_framed, all_hits_tree};
+use super::walk::all_hits_framed;
 use super::AllHitsOptions;
 use crate::prepared::PreparedScene;
 use crate::{Error, Hit, Ray};
@@ -27,7 +27,7 @@ impl AllHits {
     /// batch into chunks and [`AllHits::append`]s their lists). [`Error::NotPrepared`] for a
     /// scene without a wide tree.
     pub fn trace(scene: &PreparedScene, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
-        let tree = all_hits_tree(scene)?;
+        let tree = scene.query_tree()?;
         let mut out = AllHits::default();
         let mut stack = Vec::new();
         out.offsets.reserve(rays.len());

@@ -21,7 +21,7 @@ mod walk;
 
 pub use batch::AllHits;
 pub use collect::HitList;
-pub use walk::{all_hits, all_hits_framed, all_hits_tree, Postponed};
+pub use walk::{all_hits, all_hits_framed, Postponed};
 
 /// What an all-hits query keeps of each ray's hits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

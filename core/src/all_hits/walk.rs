@@ -10,7 +10,7 @@ use crate::prepared::PreparedScene;
 use crate::traverse::begin;
 use crate::wide::traverse::{visiting_order, WideRoot};
 use crate::wide::{ChildKernel, FastKernel, WideChild, WideMemory, WideTree};
-use crate::{Error, Hit, Ray};
+use crate::{Hit, Ray};
 use alloc::vec::Vec;
 
 /// A postponed child: its slot words and the distance its box is entered at.
@@ -89,25 +89,7 @@ pub fn all_hits<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest>(
     list.finish()
 }
 
-/// The wide tree an all-hits query walks in `scene`, with where it starts: the 8-wide tree of least
-/// node area if the scene has it (the default tracer's), else the first of the others it has.
-pub fn all_hits_tree(scene: &PreparedScene) -> Result<(WideTree<'_>, WideRoot), Error> {
-    let tree = match (&scene.wide8_sah, &scene.wide8, &scene.wide4, &scene.wide4_naive) {
-        (Some(t), _, _, _) | (None, Some(t), _, _) => WideTree::Eight(t),
-        (None, None, Some(t), _) | (None, None, None, Some(t)) => WideTree::Four(t),
-        (None, None, None, None) => {
-            return Err(Error::NotPrepared {
-                method: "all hits",
-                missing: "a wide tree (prepare the scene for a wide method, as the default tracer is)",
-            })
-        }
-    };
-    let stats = tree.stats();
-    let max_steps = (stats.nodes + stats.leaves).min(u32::MAX as usize) as u32;
-    Ok((tree, WideRoot { root: tree.root(), scene_scale: scene.scene_scale(), max_steps }))
-}
-
-/// [`all_hits`] of a ray as the caller gives it, in `scene` ([`all_hits_tree`]), with the
+/// [`all_hits`] of a ray as the caller gives it, in `scene` ([`PreparedScene::query_tree`]), with the
 /// watertight test: the ray framed as every backend frames a batch
 /// ([`PreparedScene::frame_rays`]) and its hits put back in the caller's frame. A ray that no
 /// method can answer exactly gets one hit, [`Hit::REFUSED`], as a closest-hit query answers it.

@@ -335,6 +335,27 @@ impl PreparedScene {
         })
     }
 
+    /// The wide tree the queries beyond closest and any hit walk (all hits along a ray,
+    /// [`crate::all_hits`]; the nearest point, [`crate::nearest`]), with where it starts: the
+    /// 8-wide tree of least node area if the scene has it (the default tracer's), else the first
+    /// of the others it has. [`Error::NotPrepared`] for a scene prepared for BVH2, kd or stream
+    /// methods alone.
+    pub fn query_tree(&self) -> Result<(WideTree<'_>, WideRoot), Error> {
+        let tree = match (&self.wide8_sah, &self.wide8, &self.wide4, &self.wide4_naive) {
+            (Some(t), _, _, _) | (None, Some(t), _, _) => WideTree::Eight(t),
+            (None, None, Some(t), _) | (None, None, None, Some(t)) => WideTree::Four(t),
+            (None, None, None, None) => {
+                return Err(Error::NotPrepared {
+                    method: "all hits and nearest points",
+                    missing: "a wide tree (prepare the scene for a wide method, as the default tracer is)",
+                })
+            }
+        };
+        let stats = tree.stats();
+        let max_steps = (stats.nodes + stats.leaves).min(u32::MAX as usize) as u32;
+        Ok((tree, WideRoot { root: tree.root(), scene_scale: self.scene_scale(), max_steps }))
+    }
+
     /// What `method` traverses: the level-order tree with the scene box and scale.
     pub fn stream_scene(&self, method: StreamMethod) -> Result<StreamScene<'_>, Error> {
         let tree = self
