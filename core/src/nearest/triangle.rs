@@ -117,8 +117,9 @@ mod tests {
         assert_eq!(closest_point_on_triangle(Vec3::new(-1.0, -1.0, 0.0), a, b, c).point, a);
         assert_eq!(closest_point_on_triangle(Vec3::new(3.0, -1.0, 0.0), a, b, c).point, b);
         assert_eq!(closest_point_on_triangle(Vec3::new(1.0, -1.0, 0.0), a, b, c).point, Vec3::new(1.0, 0.0, 0.0));
-        let inside = closest_point_on_triangle(Vec3::new(0.5, 0.25, 3.0), a, b, c);
-        assert!(inside.u > 0.0 && inside.v > 0.0 && inside.u + inside.v < 1.0, "{inside:?}");
+        // Above the face point at u = v = 1/4, (0.5, 0.25, 0.125), along the normal (0, -1, 2).
+        let inside = closest_point_on_triangle(Vec3::new(0.5, -0.25, 1.125), a, b, c);
+        assert!((inside.u - 0.25).abs() < 1e-6 && (inside.v - 0.25).abs() < 1e-6, "{inside:?}");
     }
 
     #[test]
