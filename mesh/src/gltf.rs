@@ -109,24 +109,26 @@ fn parse_checked(
         report: LoadReport::default(),
         options,
     };
-    // Each mesh decoded once, then the placed totals checked against the limit before any copy
-    // is made: instancing multiplies a file's triangles by its node count.
+    // Each mesh decoded once, and the placed totals checked against the limit as they grow, before
+    // any copy is made: instancing multiplies a file's triangles by its node count. Checked after
+    // each placement, so the decoded meshes held (each placed at least once) stay within the
+    // limit too, however many meshes share one accessor.
     let placements = instances(&root).map_err(err)?;
     let mut decoded: Vec<Option<Decoded>> = (0..root.meshes.len()).map(|_| None).collect();
     let (mut vertices, mut triangles) = (0u64, 0u64);
+    let max_vertices = options.max_triangles.saturating_mul(3);
     for &(_, m, _) in &placements {
         if decoded[m].is_none() {
             decoded[m] = Some(loader.decode(m).map_err(err)?);
         }
         let (v, t) = decoded[m].as_ref().map_or((0, 0), Decoded::size);
         (vertices, triangles) = (vertices.saturating_add(v), triangles.saturating_add(t));
-    }
-    super::check_triangles(triangles, "the scene's nodes place", options).map_err(err)?;
-    let max_vertices = options.max_triangles.saturating_mul(3);
-    if vertices > max_vertices {
-        return Err(err(format!(
-            "the scene's nodes place {vertices} vertices, more than three per allowed triangle ({max_vertices}; LoadOptions::max_triangles, the CLI's --max-triangles)"
-        )));
+        super::check_triangles(triangles, "the scene's nodes place at least", options).map_err(err)?;
+        if vertices > max_vertices {
+            return Err(err(format!(
+                "the scene's nodes place at least {vertices} vertices, more than three per allowed triangle ({max_vertices}; LoadOptions::max_triangles, the CLI's --max-triangles)"
+            )));
+        }
     }
     loader.reserve(vertices, triangles).map_err(err)?;
     for (node, m, world) in placements {
@@ -760,14 +762,36 @@ mod tests {
         let (mesh, _) = parse(&file, "t.gltf", None, &options(2000)).unwrap();
         assert_eq!((mesh.triangles.len(), mesh.positions.len()), (2000, 4000));
         let err = parse(&file, "t.gltf", None, &options(1999)).unwrap_err().to_string();
-        assert!(err.contains("the scene's nodes place 2000 triangles, more than the limit of 1999"), "{err}");
+        assert!(err.contains("the scene's nodes place at least 2000 triangles, more than the limit of 1999"), "{err}");
         assert!(err.contains("--max-triangles"), "{err}");
         // Placed vertices are held to three per allowed triangle: one triangle of the square's four
         // vertices, placed 1000 times, is 1000 triangles and 4000 vertices.
         let one = String::from_utf8(file).unwrap().replace(r#""count":6"#, r#""count":3"#).into_bytes();
         assert!(parse(&one, "t.gltf", None, &options(1334)).is_ok());
         let err = parse(&one, "t.gltf", None, &options(1333)).unwrap_err().to_string();
-        assert!(err.contains("place 4000 vertices, more than three per allowed triangle (3999;"), "{err}");
+        assert!(err.contains("place at least 4000 vertices, more than three per allowed triangle (3999;"), "{err}");
+    }
+
+    #[test]
+    fn meshes_sharing_one_accessor_count_as_their_placements() {
+        // 1000 meshes, each the same square (one accessor pair), each placed once: decoded once
+        // per mesh, and stopped by the limit as the decoded meshes add up.
+        let meshes = vec![r#"{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}"#; 1000].join(",");
+        let nodes: Vec<String> = (0..1000).map(|i| format!(r#"{{"mesh":{i}}}"#)).collect();
+        let roots: Vec<String> = (0..1000).map(|i| i.to_string()).collect();
+        let file = String::from_utf8(square_gltf(4, &[0, 1, 2, 0, 2, 3], r#""nodes":[]"#)).unwrap().replace(
+            r#""meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"mode":4}]}],"nodes":[]"#,
+            &format!(
+                r#""meshes":[{meshes}],"nodes":[{}],"scenes":[{{"nodes":[{}]}}]"#,
+                nodes.join(","),
+                roots.join(",")
+            ),
+        );
+        let options = |max| LoadOptions { max_triangles: max, ..LoadOptions::default() };
+        let (mesh, _) = parse(file.as_bytes(), "t.gltf", None, &options(2000)).unwrap();
+        assert_eq!(mesh.triangles.len(), 2000);
+        let err = parse(file.as_bytes(), "t.gltf", None, &options(999)).unwrap_err().to_string();
+        assert!(err.contains("place at least 1000 triangles, more than the limit of 999"), "{err}");
     }
 
     #[test]
@@ -796,7 +820,11 @@ mod tests {
         );
         assert!(file.len() < 1 << 20, "{} bytes", file.len());
         let err = load(&file).unwrap_err();
-        assert!(err.contains("the scene's nodes place 81920000 triangles, more than the limit of 67108864"), "{err}");
+        // Stopped at the first placement past the limit: 16,385 of 4,096 triangles.
+        assert!(
+            err.contains("the scene's nodes place at least 67112960 triangles, more than the limit of 67108864"),
+            "{err}"
+        );
     }
 
     #[test]
