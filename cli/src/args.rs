@@ -66,6 +66,15 @@ pub enum Command {
         after_help = AFTER_HELP
     )]
     Trace(TraceArgs),
+    /// The nearest point on the mesh to each point of a NumPy point file
+    #[command(
+        long_about = "The nearest point on the mesh to each point of a NumPy point file (float, shape (N, 3)), \
+                      within --radius: a file of records (fields prim <u4, distance <f4, x y z <f4, u v <f4; \
+                      where no triangle is within the radius, prim = 0xFFFFFFFF and distance = inf), record i for \
+                      point i.",
+        after_help = AFTER_HELP
+    )]
+    Nearest(NearestArgs),
     /// Writes primary rays framing the scene, for `trace`
     #[command(
         long_about = "Writes primary rays framing the scene (a NumPy file for `trace`). --order morton (the default) \
@@ -236,6 +245,16 @@ pub struct TraceArgs {
     /// Any-hit (occlusion) queries instead of closest-hit
     #[arg(long)]
     pub any: bool,
+    /// Every hit along each ray, in order of t, instead of the closest: one record per hit, with
+    /// its ray's index (fields ray <u4, t, prim, u, v), from the 8-wide tree of least node area
+    #[arg(long, conflicts_with_all = ["any", "moller_trumbore"])]
+    pub all: bool,
+    /// With --all: at most this many hits per ray, the nearest (the rays with more are counted)
+    #[arg(long, value_name = "N", requires = "all")]
+    pub max_hits: Option<usize>,
+    /// With --all: hits at the same t count once (the lower primitive id)
+    #[arg(long, requires = "all")]
+    pub merge_equal_t: bool,
     /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
     #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
@@ -250,6 +269,40 @@ pub struct TraceArgs {
     pub max_rays: u64,
     #[command(flatten)]
     pub load: LoadFlags,
+}
+
+/// `raytrail nearest`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct NearestArgs {
+    /// Scene file, or `builtin`
+    #[arg(long, short = 's', value_name = "FILE")]
+    pub scene: String,
+    /// The NumPy point file (float, shape (N, 3))
+    #[arg(long, value_name = "POINTS.npy")]
+    pub points: String,
+    /// The NumPy file of nearest points to write
+    #[arg(long, short = 'o', value_name = "NEAREST.npy")]
+    pub out: String,
+    /// Search radius: points with no triangle this close get none
+    #[arg(long, default_value_t = f32::INFINITY, value_parser = non_negative_f32)]
+    pub radius: f32,
+    /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
+    #[arg(long, default_value = "best", value_parser = BUILDERS)]
+    pub builder: String,
+    /// Most points the point file may hold
+    #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
+    pub max_points: u64,
+    #[command(flatten)]
+    pub load: LoadFlags,
+}
+
+/// A number that is zero or more (infinity allowed), for `--radius`.
+fn non_negative_f32(s: &str) -> Result<f32, String> {
+    let x: f32 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if x.is_nan() || x < 0.0 {
+        return Err(format!("{s} is not zero or more"));
+    }
+    Ok(x)
 }
 
 /// `raytrail stress`.

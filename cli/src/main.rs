@@ -16,6 +16,7 @@ mod flags;
 mod gpu;
 mod limits;
 mod median;
+mod nearest;
 mod progress;
 mod render;
 mod run;
@@ -46,6 +47,7 @@ fn main() {
         None => run::main(cli.run),
         Some(Command::Run(a)) => run::main(a),
         Some(Command::Trace(a)) => trace::main(a),
+        Some(Command::Nearest(a)) => nearest::main(a),
         Some(Command::Rays(a)) => trace::rays_main(a),
         // The report records the command as given.
         Some(Command::Bench(a)) => bench::main(a, &raw[2.min(raw.len())..]),

@@ -53,10 +53,14 @@ const STREAM_NAME: &str = "<stream>";
 
 /// The `descr` of a hit file, as `numpy.save` writes it.
 pub const HIT_DESCR: &str = "[('t', '<f4'), ('prim', '<u4'), ('u', '<f4'), ('v', '<f4')]";
+/// The `descr` of an all-hits file (`trace --all`): each hit with the index of its ray.
+pub const LISTED_HIT_DESCR: &str = "[('ray', '<u4'), ('t', '<f4'), ('prim', '<u4'), ('u', '<f4'), ('v', '<f4')]";
 /// Bytes per ray row.
 const RAY_BYTES: usize = 32;
 /// Bytes per hit record.
 const HIT_BYTES: usize = 16;
+/// Bytes per all-hits record.
+const LISTED_HIT_BYTES: usize = 20;
 
 /// A failed `.npy` read or write: which file, and what is wrong with it.
 #[derive(Debug)]
@@ -240,6 +244,39 @@ pub fn read_rays_from(mut reader: impl Read) -> Result<Vec<Ray>, NpyError> {
     read_rays_impl(&mut reader).map_err(NpyError::stream)
 }
 
+/// Reads query points from the `.npy` file at `path`: a float array of shape `(N, 3)`, one point
+/// per row, of the dtypes [`read_rays`] takes.
+pub fn read_points(path: impl AsRef<Path>) -> Result<Vec<[f32; 3]>, NpyError> {
+    let path = path.as_ref();
+    let file = File::open(path).map_err(|e| NpyError::new(path, NpyErrorKind::Io(e)))?;
+    read_float_rows::<3>(&mut BufReader::new(file), "(N, 3)").map_err(|k| NpyError::new(path, k))
+}
+
+/// The `descr` of a nearest-point file (`raytrail nearest`).
+pub const NEAREST_DESCR: &str =
+    "[('prim', '<u4'), ('distance', '<f4'), ('x', '<f4'), ('y', '<f4'), ('z', '<f4'), ('u', '<f4'), ('v', '<f4')]";
+
+/// Writes the nearest points to `path` as a `.npy` structured array of shape `(N,)` with the dtype
+/// [`NEAREST_DESCR`]; where there is none, `prim = 0xFFFFFFFF`, `distance = inf`, `x y z` NaN and
+/// `u v` 0.
+pub fn write_nearest(path: impl AsRef<Path>, found: &[Option<raytrail::NearestPoint>]) -> Result<(), NpyError> {
+    let path = path.as_ref();
+    write_file(path, |w| {
+        write_header(w, NEAREST_DESCR, &[found.len()])?;
+        write_records(w, found, 28, |f, out| {
+            let (prim, d, p, u, v) = match f {
+                Some(f) => (f.prim, f.distance, f.point, f.u, f.v),
+                None => (Hit::NO_PRIM, f32::INFINITY, [f32::NAN; 3], 0.0, 0.0),
+            };
+            out.extend_from_slice(&prim.to_le_bytes());
+            out.extend_from_slice(&d.to_le_bytes());
+            for x in p.iter().chain([u, v].iter()) {
+                out.extend_from_slice(&x.to_le_bytes());
+            }
+        })
+    })
+}
+
 /// Writes `rays` to `path` as a little-endian float32 `.npy` array of shape `(N, 8)`, replacing
 /// any existing file only once the new one is complete.
 pub fn write_rays(path: impl AsRef<Path>, rays: &[Ray]) -> Result<(), NpyError> {
@@ -277,6 +314,29 @@ pub fn write_hits(path: impl AsRef<Path>, hits: &[Hit]) -> Result<(), NpyError> 
     write_file(path, |w| write_hits_impl(w, hits))
 }
 
+/// Writes the hit lists of `lists` to `path` as a `.npy` structured array of shape `(H,)`, one
+/// record per hit with the dtype [`LISTED_HIT_DESCR`]: the rays' lists one after another, each in
+/// order of `t`. Ray indices past `u32::MAX` are an error (the CLI's rays stay far below).
+pub fn write_hit_lists(path: impl AsRef<Path>, lists: &raytrail::AllHits) -> Result<(), NpyError> {
+    let path = path.as_ref();
+    if lists.len() > u32::MAX as usize + 1 {
+        let e = io::Error::new(io::ErrorKind::InvalidInput, "more rays than a u32 ray index can name");
+        return Err(NpyError::new(path, NpyErrorKind::Io(e)));
+    }
+    write_file(path, |w| {
+        write_header(w, LISTED_HIT_DESCR, &[lists.hits().len()])?;
+        let records: Vec<(u32, Hit)> =
+            lists.iter().enumerate().flat_map(|(i, l)| l.iter().map(move |h| (i as u32, *h))).collect();
+        write_records(w, &records, LISTED_HIT_BYTES, |(ray, hit), out| {
+            out.extend_from_slice(&ray.to_le_bytes());
+            out.extend_from_slice(&hit.t.to_le_bytes());
+            out.extend_from_slice(&hit.prim.to_le_bytes());
+            out.extend_from_slice(&hit.u.to_le_bytes());
+            out.extend_from_slice(&hit.v.to_le_bytes());
+        })
+    })
+}
+
 /// Writes `hits` in `.npy` format to `writer`, as [`write_hits`] does. The writer is not flushed.
 pub fn write_hits_to(mut writer: impl Write, hits: &[Hit]) -> Result<(), NpyError> {
     write_hits_impl(&mut writer, hits).map_err(|e| NpyError::stream(NpyErrorKind::Io(e)))
@@ -286,6 +346,17 @@ pub fn write_hits_to(mut writer: impl Write, hits: &[Hit]) -> Result<(), NpyErro
 // Rays and hits over the generic machinery.
 
 fn read_rays_impl(r: &mut impl Read) -> Result<Vec<Ray>, NpyErrorKind> {
+    let rows = read_float_rows::<8>(r, "(N, 8)")?;
+    Ok(rows
+        .into_iter()
+        .map(|f| Ray { origin: [f[0], f[1], f[2]], tmin: f[3], dir: [f[4], f[5], f[6]], tmax: f[7] })
+        .collect())
+}
+
+/// The rows of a float array of shape `(N, C)` in C order (`<f4`, `>f4`, or `<f8`/`>f8` rounded to
+/// float32, beyond its range to infinity; NaN stays NaN); `shape` names the expected shape in
+/// errors.
+fn read_float_rows<const C: usize>(r: &mut impl Read, shape: &'static str) -> Result<Vec<[f32; C]>, NpyErrorKind> {
     const EXPECTED_DTYPE: &str = "float32 ('<f4' or '>f4') or float64 ('<f8' or '>f8')";
     let header = read_header(r)?;
     let Value::Str(descr) = &header.descr else {
@@ -295,14 +366,14 @@ fn read_rays_impl(r: &mut impl Read) -> Result<Vec<Ray>, NpyErrorKind> {
         .filter(|s| s.kind == b'f' && (s.size == 4 || s.size == 8))
         .ok_or_else(|| NpyErrorKind::WrongDtype { found: header.descr.to_string(), expected: EXPECTED_DTYPE })?;
     let n = match header.shape[..] {
-        [n, 8] => n,
-        _ => return Err(NpyErrorKind::WrongShape { found: header.shape, expected: "(N, 8)" }),
+        [n, c] if c == C as u64 => n,
+        _ => return Err(NpyErrorKind::WrongShape { found: header.shape, expected: shape }),
     };
     check_order(&header)?;
-    let row_bytes = 8 * scalar.size;
+    let row_bytes = C * scalar.size;
     let total = byte_size(&header.shape, row_bytes)?;
     read_records(r, n, row_bytes, total, |row| {
-        let mut f = [0.0f32; 8];
+        let mut f = [0.0f32; C];
         for (i, x) in f.iter_mut().enumerate() {
             *x = if scalar.size == 4 {
                 f32::from_bits(u32_at(row, 4 * i, scalar.big_endian))
@@ -311,7 +382,7 @@ fn read_rays_impl(r: &mut impl Read) -> Result<Vec<Ray>, NpyErrorKind> {
                 f64::from_bits(u64_at(row, 8 * i, scalar.big_endian)) as f32
             };
         }
-        Ray { origin: [f[0], f[1], f[2]], tmin: f[3], dir: [f[4], f[5], f[6]], tmax: f[7] }
+        f
     })
 }
 
