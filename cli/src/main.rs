@@ -18,6 +18,7 @@ mod limits;
 mod median;
 mod nearest;
 mod progress;
+mod queries;
 mod render;
 mod run;
 mod stress;

@@ -143,6 +143,8 @@ pub fn main(a: RunArgs) -> Outcome {
     print_backtracking(&per_set);
     print_kd(&per_set);
     print_stream(&tables);
+    let camera = sets.first().map_or(&[][..], |s| s.rays.as_slice());
+    let query_failures = crate::queries::print_queries(&backend, &prepared, scene, builder, camera)?;
     let refused: Vec<String> = tables
         .iter()
         .filter(|t| t.refused > 0)
@@ -160,14 +162,16 @@ pub fn main(a: RunArgs) -> Outcome {
             if gpu.is_some() { ", on the GPU as on the CPU, and the GPU matches the CPU ray by ray" } else { "" },
             if refused.is_empty() { "" } else { "; refused rays are left out of that: see above" }
         );
-        Ok(0)
     } else {
         outln!("\nCONFORMANCE FAILED: {} mismatches. The first ones:", failures.len());
         for m in failures.iter().take(5) {
             outln!("{m}");
         }
-        Ok(1)
     }
+    if query_failures > 0 {
+        outln!("\nQUERY CHECKS FAILED: {query_failures} lists, points or refit hits differ (see the queries table)");
+    }
+    Ok(if failures.is_empty() && query_failures == 0 { 0 } else { 1 })
 }
 
 fn ray_sets(

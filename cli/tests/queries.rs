@@ -140,3 +140,15 @@ fn nearest_points_are_the_library_s() {
     assert_eq!(bad.status.code(), Some(2), "{}", String::from_utf8_lossy(&bad.stderr));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--radius"));
 }
+
+#[test]
+fn the_main_job_times_and_checks_the_queries() {
+    let out = run(&[&"run", &"--width", &"32", &"--height", &"24", &"--no-gpu", &"--passes", &"1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    for line in ["all hits", "nearest", "refit"] {
+        let found =
+            text.lines().find(|l| l.trim_start().starts_with(line)).unwrap_or_else(|| panic!("no {line} line: {text}"));
+        assert!(found.contains(" 0 of "), "{found}");
+    }
+}
