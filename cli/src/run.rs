@@ -36,8 +36,9 @@ struct SetResult<'a> {
     stream: Option<StreamStats>,
     /// Rays refused as outside the supported numeric range (the most any method refused).
     refused: usize,
-    /// What `--method auto` chooses for the set (the default method of `trace`).
-    auto: raytrail::analysis::choice::Choice,
+    /// What `--method auto` chooses for the set (the default method of `trace`); `None` for a
+    /// set without rays (the shadow and diffuse rays of a scene whose camera rays hit nothing).
+    auto: Option<raytrail::analysis::choice::Choice>,
 }
 
 struct RaySetRun {
@@ -108,8 +109,12 @@ pub fn main(a: RunArgs) -> Outcome {
             refused = refused.max(counted.refused);
             rows.push((method, median(&times), counted.counters.unwrap_or_default()));
         }
-        let auto = raytrail::analysis::sample::choose_on_cpu(&backend, &cpu, &set.rays, set.query)
-            .map_err(|e| format!("auto: {e}"))?;
+        let auto = if set.rays.is_empty() {
+            None
+        } else {
+            let c = raytrail::analysis::sample::choose_on_cpu(&backend, &cpu, &set.rays, set.query);
+            Some(c.map_err(|e| format!("auto: {e}"))?)
+        };
         progress.step(&format!("{} auto", set.name));
         // Conformance on an evenly spread subset: recording every node of every ray is heavy.
         let step = set.rays.len().div_ceil(check_rays.max(1)).max(1);
@@ -323,7 +328,10 @@ fn print_table(t: &SetResult<'_>, prepared: &PreparedScene) {
         );
     }
     // What `--method auto` (the default of `raytrail trace`) picks here, and against what.
-    let a = &t.auto;
+    let Some(a) = &t.auto else {
+        outln!("  auto: no rays to choose on (the camera rays hit nothing, so there are no {} rays)", set.name);
+        return;
+    };
     let chosen_s = t.rows.iter().find(|r| r.0 == a.method).map_or(f64::NAN, |r| r.1);
     let fastest = t.rows.iter().min_by(|x, y| x.1.total_cmp(&y.1));
     outln!(

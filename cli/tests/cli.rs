@@ -203,3 +203,19 @@ fn render_with_auto_draws_what_its_chosen_method_draws() {
     run(&chosen, &fixed_png);
     assert_eq!(std::fs::read(&auto_png).unwrap(), std::fs::read(&fixed_png).unwrap(), "auto chose {chosen}");
 }
+
+#[test]
+fn the_main_job_on_a_scene_the_camera_rays_miss_says_so_and_passes() {
+    // Two degenerate triangles on a line: every camera ray misses, so there are no shadow or
+    // diffuse rays to choose a method on (it failed with "auto: invalid rays").
+    let scene = tmp("degenerate.obj");
+    std::fs::write(&scene, "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 3 2\n").unwrap();
+    let out =
+        bin().args(["run", "--no-gpu", "--width", "16", "--height", "12", "--scene"]).arg(&scene).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        text.contains("auto: no rays to choose on (the camera rays hit nothing, so there are no shadow rays)"),
+        "{text}"
+    );
+}

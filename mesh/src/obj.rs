@@ -44,6 +44,14 @@ pub(super) fn parse(data: &[u8], name: &str, options: &LoadOptions) -> Result<(M
         Cow::Owned(owned)
     };
 
+    // A relative reference out of range makes tobj's index arithmetic overflow (a panic with
+    // overflow checks on, caught below but printed by the panic hook): such files are checked
+    // first, which costs a pass only where a face has a `-` in it.
+    if scan.relative {
+        if let Some((line, why)) = locate_bad_reference(&text) {
+            return Err(MeshError::at_line(name, line, why));
+        }
+    }
     let mut reader = Tracked { data: &text, pos: 0 };
     let tobj_options = tobj::LoadOptions {
         triangulate: true,
@@ -148,10 +156,19 @@ struct Prescan {
     report: LoadReport,
     /// Triangles the kept faces make (`n - 2` for a face of `n` vertices).
     triangles: u64,
+    /// Whether some face has a relative (negative) reference, which tobj resolves with
+    /// arithmetic that overflows on a hostile one.
+    relative: bool,
 }
 
 fn prescan(data: &[u8], options: &LoadOptions) -> Prescan {
-    let mut scan = Prescan { comment_out: Vec::new(), strict_error: None, report: LoadReport::default(), triangles: 0 };
+    let mut scan = Prescan {
+        comment_out: Vec::new(),
+        strict_error: None,
+        report: LoadReport::default(),
+        triangles: 0,
+        relative: false,
+    };
     for (i, (start, line)) in lines(data).enumerate() {
         let line_no = i + 1;
         // Words as tobj splits them (Unicode whitespace) where the line is text it can read.
@@ -181,6 +198,7 @@ fn prescan(data: &[u8], options: &LoadOptions) -> Prescan {
             }
             Some(b"f") => {
                 scan.triangles += (count - 2) as u64;
+                scan.relative |= line.contains(&b'-');
                 // Sources only while within the limit: past it the load fails before tobj runs.
                 if options.sources && scan.triangles <= options.max_triangles {
                     let n = count - 2;
@@ -423,6 +441,23 @@ mod tests {
         // overflows (a panic when overflow checks are on, an error otherwise).
         let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/-9 2/1 3/1\n");
         assert!(e.starts_with("t.obj:5: face refers to texture coordinate -9"), "{e}");
+    }
+
+    #[test]
+    fn hostile_relative_references_never_reach_tobj() {
+        // The fuzzer's input of issue 55 (a normal -100 with two normals defined), and the one
+        // above: refused by the pre-check, so tobj's arithmetic never overflows (its panic, though
+        // caught, printed a backtrace in debug builds).
+        let fuzzed = "| a\nv 0 0 00\nvn 0 00 0\nv0\nvn 0 0 1\nf 1/v00/0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvf 0 1\n\
+f 1/1/1 2/1/  -1 \nf 1/1/1 2/1/1 3/1/-100 0\nvn -2 -3 0 0 1\nf 1/1\nf 1/v0000 0\nvn 0 0 1\nf 1/v0\nf \n1 2 3f 1 2 3";
+        for (text, line) in [(fuzzed, 13), ("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/-9 2/1 3/1\n", 5)] {
+            let e = err(text);
+            assert!(e.starts_with(&format!("t.obj:{line}: face refers to ")), "{e}");
+            assert!(!e.contains("panicked"), "{e}");
+        }
+        // Relative references in range load as before.
+        let m = parse(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n", "t.obj", &LoadOptions::default()).unwrap().0;
+        assert_eq!(m.triangles, [[0, 1, 2]]);
     }
 
     #[test]
