@@ -15,15 +15,12 @@ Differences, all on the side of exactness:
 
 - Rays start at their origin (``t >= 0``) and are traced in float32 (as embree does); hit
   locations are then computed in float64, where the ray meets the plane of the face hit.
-- ``multiple_hits=True`` re-traces each ray that hit from just past its last hit: the same ray
-  (origin and direction unchanged), its ``tmin`` moved to the next float32 after the last hit's
-  ``t``. So hits come in order of ``t`` along each ray, no face is reported twice and none is
-  skipped, except that of faces hit at exactly the same ``t`` (a ray through a shared edge or
-  vertex) only the lowest index is reported. (raytrail moves an origin far from the mesh up to
-  it before testing, from the ray's ``tmin``, so a face's ``t`` can shift by a float32 step
-  between rounds: a face found again is recognized and skipped, and two faces within such a
-  step of each other count as a tie.) trimesh's own loops instead move the origin past each hit
-  by a fixed offset, which can skip a close face or repeat one.
+- ``multiple_hits=True`` lists every hit along each ray in one walk (``Scene.intersect_all``): in
+  order of ``t`` along each ray, no face twice and none skipped, except that of faces hit at
+  exactly the same ``t`` (a ray through an edge or vertex they share) only the lowest index is
+  reported: one crossing of the surface, as the parity test of ``contains_points`` counts them.
+  trimesh's own loops instead move the origin past each hit by a fixed offset, which can skip a
+  close face or repeat one.
 """
 
 import numpy as np
@@ -31,9 +28,6 @@ import numpy as np
 from ._raytrail import Scene
 
 __all__ = ["RayMeshIntersector"]
-
-# How many of a ray's last faces a re-trace checks a new hit against (see intersects_id).
-_RECENT = 4
 
 
 def _rays(ray_origins, ray_directions):
@@ -143,45 +137,20 @@ class RayMeshIntersector:
             The hit points, only with ``return_locations``.
         """
         origins, directions, rays = _rays(ray_origins, ray_directions)
-        scene = self.scene
         max_hits = max(int(max_hits), 1) if multiple_hits else 1
-        tris, ids, ts = [], [], []
-        live = np.arange(len(rays))
-        count = np.zeros(len(rays), dtype=np.int64)
-        # The last faces each ray reported (-1: none yet), to recognize a face found again.
-        recent = np.full((len(rays), _RECENT), -1, dtype=np.int64)
-        # Each round either records a hit or moves a ray's tmin strictly forward past a repeat,
-        # so this ends; the cap only bounds pathological stacks of repeats.
-        for _ in range(2 * max_hits + _RECENT):
-            if len(live) == 0:
-                break
-            batch = rays if len(live) == len(rays) else rays[live]
-            hits = scene.intersect(batch)
-            hit = hits.prim >= 0
-            live, prim, t = live[hit], hits.prim[hit], hits.t[hit]
-            if len(live) == 0:
-                break
-            # The same ray again, starting just past this hit: only faces farther along it remain,
-            # and equal-t ties were settled by the lowest index.
-            rays[live, 3] = np.nextafter(t, np.float32(np.inf))
-            # raytrail moves an origin far from the mesh (over 4 times its size) up to the mesh
-            # before testing, from the ray's tmin; so a face's t can come out a float32 step or two
-            # different when tmin changes, and the face just reported can be found again just past
-            # it. Such a repeat is skipped, not reported.
-            new = ~(recent[live] == prim[:, None]).any(axis=1)
-            rec, rec_prim = live[new], prim[new]
-            tris.append(rec_prim)
-            ids.append(rec)
-            ts.append(t[new])
-            recent[rec] = np.roll(recent[rec], 1, axis=1)
-            recent[rec, 0] = rec_prim
-            count[rec] += 1
-            live = live[count[live] < max_hits]
-        index_tri = np.concatenate(tris) if tris else np.zeros(0, dtype=np.int64)
-        index_ray = np.concatenate(ids) if ids else np.zeros(0, dtype=np.int64)
+        # Every hit in one walk per ray (Scene.intersect_all), each face once. Faces hit at the same
+        # t (a ray through an edge or vertex they share) count once, the lowest index: one crossing
+        # of the surface, as trimesh's parity test for contains_points needs.
+        ray, t, prim, _, _, _ = self.scene.intersect_all(rays, max_hits=max_hits, merge_equal_t=True)
+        # A ray refused as too far from the mesh has one entry with prim REFUSED: no hit here.
+        keep = prim >= 0
+        ray, t, prim = ray[keep], t[keep], prim[keep]
+        # By round, as trimesh orders them: every ray's first hit, then every second hit, ...
+        rank = np.arange(len(ray)) - np.searchsorted(ray, ray, side="left")
+        order = np.lexsort((ray, rank))
+        index_tri, index_ray, t = prim[order], ray[order], t[order]
         if not return_locations:
             return index_tri, index_ray
-        t = np.concatenate(ts) if ts else np.zeros(0, dtype=np.float32)
         return index_tri, index_ray, self._locations(origins, directions, index_tri, index_ray, t)
 
     def _locations(self, origins, directions, index_tri, index_ray, t):
