@@ -455,10 +455,13 @@ pub fn check_input(flag: &str, path: &str) -> Result<(), Failure> {
     if path == BUILTIN_SCENE {
         return Ok(());
     }
+    use std::os::unix::fs::FileTypeExt;
     let what = match std::fs::metadata(path) {
         Ok(m) if m.is_file() => return Ok(()),
+        // A pipe (`--scene <(zcat mesh.obj.gz)`) is read as a stream.
+        Ok(m) if m.file_type().is_fifo() => return Ok(()),
         Ok(m) if m.is_dir() => "it is a folder, not a file",
-        Ok(_) => "it is a pipe or a device, not a file (the loaders read files they can seek in)",
+        Ok(_) => "it is a device, not a file or a pipe",
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => "no such file",
         Err(e) => return Err(Failure::Run(format!("--{flag}: {path}: {e}"))),
     };

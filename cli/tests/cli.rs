@@ -219,3 +219,45 @@ fn the_main_job_on_a_scene_the_camera_rays_miss_says_so_and_passes() {
         "{text}"
     );
 }
+
+/// `rays --scene /dev/stdin --max-mesh-bytes max` with `data` written to its stdin (a pipe).
+fn rays_from_stdin(data: Vec<u8>, max: &str) -> std::process::Output {
+    use std::io::Write;
+    let mut child = bin()
+        .args(["rays", "--scene", "/dev/stdin", "--width", "8", "--height", "6", "--max-mesh-bytes", max, "--out"])
+        .arg(tmp("stdin-rays.npy"))
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    // The reader may stop early (past the limit): a failed write is its answer, not an error.
+    let writer = std::thread::spawn(move || {
+        let _ = stdin.write_all(&data);
+    });
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    out
+}
+
+#[test]
+fn a_mesh_from_a_pipe_is_read_as_a_stream_with_its_format_from_its_content() {
+    use std::io::Write;
+    let teapot = std::fs::read(mesh_path("teapot.obj")).unwrap();
+    // OBJ has no magic number: a pipe has no extension, so the content says what it is.
+    let out = rays_from_stdin(teapot.clone(), "100000000");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    gz.write_all(&teapot).unwrap();
+    let out = rays_from_stdin(gz.finish().unwrap(), "100000000");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // A stream says nothing of its size: past --max-mesh-bytes it is an error, not a hang.
+    let out = rays_from_stdin(vec![b'#'; 1 << 20], "100000");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("a stream longer than 100000 bytes"), "{err}");
+    // A device is no mesh.
+    let out = bin().args(["rays", "--scene", "/dev/zero", "--out"]).arg(tmp("zero.npy")).output().unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("it is a device, not a file or a pipe"));
+}

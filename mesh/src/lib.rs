@@ -222,11 +222,13 @@ pub fn load(path: &Path) -> Result<Mesh, MeshError> {
 ///
 /// Gzip is recognised by its magic bytes, whatever the name; the format then comes from the
 /// extension (after any `.gz`), or from the content for other names (PLY, OFF, GLB and glTF JSON
-/// by their first bytes; STL by its `solid` keyword or its size). A `.gltf` file's external
-/// buffers are read from the file's folder.
+/// by their first bytes; STL by its `solid` keyword or its size; OBJ, which has no magic, by a
+/// first statement of OBJ's where the name has no extension at all). A `.gltf` file's external buffers are read from the file's folder.
+/// A path that is a pipe (`<(zcat mesh.obj.gz)`) is read as a stream, up to
+/// [`LoadOptions::max_inflated`] bytes.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<(Mesh, LoadReport), MeshError> {
     let name = path.display().to_string();
-    let data = std::fs::read(path).map_err(|e| MeshError::io(&name, "cannot read file", e))?;
+    let data = read_input(path, options.max_inflated).map_err(|e| MeshError::io(&name, "cannot read file", e))?;
     let dir = path.parent().map(|d| if d.as_os_str().is_empty() { Path::new(".") } else { d });
     load_data(&data, &name, dir, options)
 }
@@ -259,6 +261,23 @@ pub fn load_ply(mut reader: impl BufRead, name: &str) -> Result<Mesh, MeshError>
     let mut data = Vec::new();
     reader.read_to_end(&mut data).map_err(|e| MeshError::io(name, "read failed", e))?;
     ply::parse(&data, name, &LoadOptions::default()).map(|(mesh, _)| mesh)
+}
+
+/// The bytes of `path`: a file whole, a stream (a pipe, `<(zcat mesh.obj.gz)`) up to `max`
+/// bytes, past which it is an error (a stream says nothing of its size, and `<(yes)` never ends).
+fn read_input(path: &Path, max: u64) -> io::Result<Vec<u8>> {
+    let file = std::fs::File::open(path)?;
+    if file.metadata()?.is_file() {
+        return std::fs::read(path);
+    }
+    let mut data = Vec::new();
+    file.take(max.saturating_add(1)).read_to_end(&mut data)?;
+    if data.len() as u64 > max {
+        return Err(io::Error::other(std::format!(
+            "a stream longer than {max} bytes, the limit for meshes read from a pipe (LoadOptions::max_inflated; the CLI's --max-mesh-bytes)"
+        )));
+    }
+    Ok(data)
 }
 
 const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
@@ -318,6 +337,10 @@ fn format_of(format_name: &str, data: &[u8]) -> Option<Format> {
         Some(Format::Off)
     } else if stl::has_magic(data) {
         Some(Format::Stl)
+    } else if !format_name.rsplit('/').next().unwrap_or(format_name).contains('.') && obj::has_magic(data) {
+        // Only for a name without an extension (a pipe: `/dev/fd/63`, `/dev/stdin`): a file
+        // named `.3ds` holding OBJ-like text is more likely misnamed than OBJ.
+        Some(Format::Obj)
     } else {
         None
     }
@@ -446,6 +469,18 @@ endloop\nendfacet\nendsolid t\n";
     }
 
     #[test]
+    fn obj_without_a_name_to_go_by_is_known_by_its_statements() {
+        for text in [
+            &b"# a comment\n\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"[..],
+            b"mtllib a.mtl\no x\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        ] {
+            assert_eq!(load_bytes(text, "/dev/fd/63").map(|m| m.triangles.len()).map_err(|e| e.to_string()), Ok(1));
+        }
+        let err = load_bytes(b"hello\nv 0 0 0\n", "/dev/fd/63").unwrap_err().to_string();
+        assert!(err.contains("unknown mesh format"), "{err}");
+    }
+
+    #[test]
     fn every_format_refuses_triangles_past_the_limit() {
         let quad_ply = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
 property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
@@ -496,7 +531,10 @@ vertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
         let mut bin = std::vec![0u8; 84 + 50];
         bin[80] = 1;
         assert_eq!(format_of("x", &bin), Some(Format::Stl));
-        assert_eq!(format_of("x", QUAD_OBJ), None);
+        // OBJ, which has no magic, by its statements, but only without an extension to go by.
+        assert_eq!(format_of("x", QUAD_OBJ), Some(Format::Obj));
+        assert_eq!(format_of("/dev/fd/63", QUAD_OBJ), Some(Format::Obj));
+        assert_eq!(format_of("mesh.data", QUAD_OBJ), None);
     }
 
     #[test]

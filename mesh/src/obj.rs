@@ -29,6 +29,20 @@ use std::panic::{self, AssertUnwindSafe};
 use std::string::String;
 use std::vec::Vec;
 
+/// Whether `data` reads as OBJ text, for data without a file name to go by (a pipe): its first
+/// statement (past blank lines and `#` comments, within the first 64 KiB) is one of OBJ's
+/// (`v`, `vt`, `vn`, `f`, `o`, `g`, `s`, `l`, `p`, `mtllib`, `usemtl`). OBJ has no magic number,
+/// so this is tried after every format that has one, and only for a name without an extension.
+pub(super) fn has_magic(data: &[u8]) -> bool {
+    const STATEMENTS: [&[u8]; 11] = [b"v", b"vt", b"vn", b"f", b"o", b"g", b"s", b"l", b"p", b"mtllib", b"usemtl"];
+    let head = &data[..data.len().min(1 << 16)];
+    head.split(|&b| b == b'\n')
+        .map(|line| line.trim_ascii())
+        .find(|line| !line.is_empty() && !line.starts_with(b"#"))
+        .and_then(|line| super::words(line).next())
+        .is_some_and(|w| STATEMENTS.contains(&w))
+}
+
 /// Parses OBJ text; `name` is used in errors.
 pub(super) fn parse(data: &[u8], name: &str, options: &LoadOptions) -> Result<(Mesh, LoadReport), MeshError> {
     let mut scan = prescan(data, options);
