@@ -4,9 +4,10 @@
 //!
 //! - [`AllHitsOptions`]: at most how many hits per ray, and whether hits at one distance count
 //!   once;
-//! - [`collect`]: the list of one ray as it is found (sorted, merged and cut to the limit, which
-//!   then culls the walk);
-//! - [`walk`]: the walk of a wide tree that finds them ([`all_hits`]);
+//! - [`HitList`] (`collect.rs`): the list of one ray as it is found (sorted, merged and cut to the
+//!   limit, which then culls the walk);
+//! - [`all_hits`] (`walk.rs`): the walk of a wide tree that finds them, and [`all_hits_framed`]
+//!   for a ray as the caller gives it;
 //! - [`AllHits`]: the lists of a batch, one after another.
 //!
 //! Each triangle is in exactly one leaf and each leaf is visited at most once per ray, so no

@@ -4,8 +4,9 @@
 //!
 //! - [`closest_point_on_triangle`]: one triangle, exactly the region rule (vertex, edge or face
 //!   nearest) in `f32`;
-//! - [`walk`]: a wide tree walked nearest box first, culling boxes farther than the best
-//!   distance so far ([`nearest_point`]), and a batch ([`nearest_points`]).
+//! - [`nearest_point_in`] (`walk.rs`): a wide tree walked nearest box first, culling boxes
+//!   farther than the best distance so far; [`nearest_point`] in a prepared scene's frame, and a
+//!   batch ([`nearest_points`]).
 //!
 //! Ties (two triangles at one distance, as at a shared edge or vertex) go to the lower primitive
 //! id, as hits do, so the answer does not depend on the tree.
