@@ -9,7 +9,7 @@ use raytrail::mesh::{write_sources_csv, LoadOptions, LoadReport};
 use raytrail::Builder;
 use raytrail_cli::write::same_file;
 use raytrail_conformance::NamedScene;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 const AFTER_HELP: &str = "\
 METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash-resume (BVH2);
@@ -198,7 +198,7 @@ pub struct AccuracyArgs {
 pub struct RunArgs {
     /// Scene file, or `builtin`
     #[arg(long, short = 's', value_name = "FILE", default_value = BUILTIN_SCENE)]
-    pub scene: String,
+    pub scene: PathBuf,
     /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
     #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
@@ -232,16 +232,16 @@ pub struct RunArgs {
 pub struct TraceArgs {
     /// Scene file, or `builtin`
     #[arg(long, short = 's', value_name = "FILE")]
-    pub scene: String,
+    pub scene: PathBuf,
     /// The NumPy ray file to trace
     #[arg(long, value_name = "RAYS.npy")]
-    pub rays: String,
+    pub rays: PathBuf,
     /// Traversal method, or auto: the fastest of a few candidates timed on a sample of the rays
     #[arg(long, short = 'm', default_value = AUTO, value_parser = method_names_or_auto(), hide_possible_values = true)]
     pub method: String,
     /// The NumPy hit file to write
     #[arg(long, short = 'o', value_name = "HITS.npy")]
-    pub out: String,
+    pub out: PathBuf,
     /// Any-hit (occlusion) queries instead of closest-hit
     #[arg(long)]
     pub any: bool,
@@ -263,7 +263,7 @@ pub struct TraceArgs {
     pub moller_trumbore: bool,
     /// Also write where in the mesh file each primitive id comes from (CSV: prim,file,<where>)
     #[arg(long, value_name = "FILE.csv")]
-    pub prim_map: Option<String>,
+    pub prim_map: Option<PathBuf>,
     /// Most rays the ray file may hold
     #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
     pub max_rays: u64,
@@ -276,13 +276,13 @@ pub struct TraceArgs {
 pub struct NearestArgs {
     /// Scene file, or `builtin`
     #[arg(long, short = 's', value_name = "FILE")]
-    pub scene: String,
+    pub scene: PathBuf,
     /// The NumPy point file (float, shape (N, 3))
     #[arg(long, value_name = "POINTS.npy")]
-    pub points: String,
+    pub points: PathBuf,
     /// The NumPy file of nearest points to write
     #[arg(long, short = 'o', value_name = "NEAREST.npy")]
-    pub out: String,
+    pub out: PathBuf,
     /// Search radius: points with no triangle this close get none
     #[arg(long, default_value_t = f32::INFINITY, value_parser = non_negative_f32)]
     pub radius: f32,
@@ -318,16 +318,16 @@ pub struct StressArgs {
 pub struct ExplainArgs {
     /// Scene file, or `builtin`
     #[arg(value_name = "SCENE")]
-    pub scene: String,
+    pub scene: PathBuf,
     /// A NumPy ray file to choose a method for (instead of the generated ray types)
     #[arg(long, value_name = "RAYS.npy")]
-    pub rays: Option<String>,
+    pub rays: Option<PathBuf>,
     /// The --rays are any-hit (occlusion) queries
     #[arg(long, requires = "rays")]
     pub any: bool,
     /// Also write the analysis as JSON
     #[arg(long, value_name = "FILE")]
-    pub json: Option<String>,
+    pub json: Option<PathBuf>,
     /// BVH2 builder: `best` builds with both and keeps the tree of the lower SAH cost
     #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
@@ -355,10 +355,10 @@ pub const ORDERS: [&str; 2] = ["morton", "raster"];
 pub struct RaysArgs {
     /// Scene file, or `builtin`
     #[arg(long, short = 's', value_name = "FILE")]
-    pub scene: String,
+    pub scene: PathBuf,
     /// The NumPy ray file to write
     #[arg(long, short = 'o', value_name = "RAYS.npy")]
-    pub out: String,
+    pub out: PathBuf,
     /// Image width
     #[arg(long, short = 'W', default_value_t = 320, value_parser = clap::value_parser!(u32).range(1..))]
     pub width: u32,
@@ -384,10 +384,10 @@ pub const RENDER_MODES: [&str; 4] = ["normals", "ao", "heat", "backtracks"];
 pub struct RenderArgs {
     /// Scene file, or `builtin`
     #[arg(long, short = 's', value_name = "FILE", default_value = BUILTIN_SCENE)]
-    pub scene: String,
+    pub scene: PathBuf,
     /// The PNG file to write
     #[arg(long, short = 'o', value_name = "IMAGE.png")]
-    pub out: String,
+    pub out: PathBuf,
     /// What to draw: normals (shaded by the hit triangle's normal), ao (ambient occlusion), heat
     /// (nodes visited per pixel by --method) or backtracks (backtracking steps per pixel by
     /// --method); heat maps run on a log scale from dark blue (none) to red (the image's most)
@@ -433,29 +433,35 @@ pub fn ploc_note(builder: Builder, scene: &raytrail::core::scene::Scene) {
     }
 }
 
+/// Whether `path` names the built-in scene rather than a file.
+pub fn is_builtin(path: &Path) -> bool {
+    path.as_os_str() == BUILTIN_SCENE
+}
+
 /// Checks that `path` can be written as an output: its folder exists and it is not a folder.
-pub fn check_output(flag: &str, path: &str) -> Result<(), Failure> {
-    let p = Path::new(path);
-    if path.is_empty() {
+pub fn check_output(flag: &str, path: &Path) -> Result<(), Failure> {
+    let shown = path.display();
+    if path.as_os_str().is_empty() {
         return usage(format!("--{flag}: empty path"));
     }
-    if p.is_dir() {
-        return usage(format!("--{flag}: cannot write {path}: it is a folder"));
+    if path.is_dir() {
+        return usage(format!("--{flag}: cannot write {shown}: it is a folder"));
     }
-    let dir = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {
-        return usage(format!("--{flag}: cannot write {path}: its folder {} does not exist", dir.display()));
+        return usage(format!("--{flag}: cannot write {shown}: its folder {} does not exist", dir.display()));
     }
     Ok(())
 }
 
 /// Checks that the input file `path` exists (`builtin` is no file): a failure (exit status 1)
 /// found before any work, saying what the path is when it is there but no file.
-pub fn check_input(flag: &str, path: &str) -> Result<(), Failure> {
-    if path == BUILTIN_SCENE {
+pub fn check_input(flag: &str, path: &Path) -> Result<(), Failure> {
+    if is_builtin(path) {
         return Ok(());
     }
     use std::os::unix::fs::FileTypeExt;
+    let shown = path.display();
     let what = match std::fs::metadata(path) {
         Ok(m) if m.is_file() => return Ok(()),
         // A pipe (`--scene <(zcat mesh.obj.gz)`) is read as a stream.
@@ -463,28 +469,31 @@ pub fn check_input(flag: &str, path: &str) -> Result<(), Failure> {
         Ok(m) if m.is_dir() => "it is a folder, not a file",
         Ok(_) => "it is a device, not a file or a pipe",
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => "no such file",
-        Err(e) => return Err(Failure::Run(format!("--{flag}: {path}: {e}"))),
+        Err(e) => return Err(Failure::Run(format!("--{flag}: {shown}: {e}"))),
     };
-    Err(Failure::Run(format!("--{flag}: {path}: {what}")))
+    Err(Failure::Run(format!("--{flag}: {shown}: {what}")))
 }
 
 /// Refuses, before any work, an output that is one of the command's inputs (the same file by
 /// device and inode, however it is spelled or linked: `trace --out` naming the ray file would
 /// destroy it), or the same file as another output. Devices and pipes (`/dev/null`) may be named
 /// more than once.
-pub fn check_distinct(inputs: &[(&str, &str)], outputs: &[(&str, &str)]) -> Result<(), Failure> {
+pub fn check_distinct(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Result<(), Failure> {
     for (i, &(flag, path)) in outputs.iter().enumerate() {
         for &(input_flag, input) in inputs {
-            if input != BUILTIN_SCENE && same_file(path, input) {
+            if !is_builtin(input) && same_file(path, input) {
                 return usage(format!(
-                    "--{flag} {path} is the input --{input_flag} {input}: writing it would destroy the input; name another file"
+                    "--{flag} {} is the input --{input_flag} {}: writing it would destroy the input; name another file",
+                    path.display(),
+                    input.display()
                 ));
             }
         }
         for &(other_flag, other) in &outputs[i + 1..] {
             if same_output(path, other) {
                 return usage(format!(
-                    "--{flag} and --{other_flag} name one file ({path}): one would overwrite the other"
+                    "--{flag} and --{other_flag} name one file ({}): one would overwrite the other",
+                    path.display()
                 ));
             }
         }
@@ -493,31 +502,31 @@ pub fn check_distinct(inputs: &[(&str, &str)], outputs: &[(&str, &str)]) -> Resu
 }
 
 /// Whether two outputs name one regular file, whether or not it exists yet.
-fn same_output(a: &str, b: &str) -> bool {
-    let regular = |p: &str| std::fs::metadata(p).map_or(true, |m| m.is_file());
+fn same_output(a: &Path, b: &Path) -> bool {
+    let regular = |p: &Path| std::fs::metadata(p).map_or(true, |m| m.is_file());
     if !regular(a) || !regular(b) {
         return false;
     }
     // Not there yet: the same folder (by identity) and the same name.
     let folder = |p: &Path| p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
-    let (a, b) = (Path::new(a), Path::new(b));
     same_file(a, b) || (a.file_name() == b.file_name() && same_file(folder(a), folder(b)))
 }
 
 /// Loads a scene (a mesh file or `builtin`) with `options`; returns the warning line to print
 /// when loading skipped elements (print it with [`warn`] once any progress line is done).
-pub fn load_scene(path: &str, options: &LoadOptions) -> Result<(NamedScene, LoadReport, Option<String>), String> {
-    if path == BUILTIN_SCENE {
+pub fn load_scene(path: &Path, options: &LoadOptions) -> Result<(NamedScene, LoadReport, Option<String>), String> {
+    if is_builtin(path) {
         return Ok((builtin_scene(), LoadReport::default(), None));
     }
-    let (mesh, report) = raytrail::mesh::load_with(Path::new(path), options).map_err(|e| e.to_string())?;
+    let shown = path.display();
+    let (mesh, report) = raytrail::mesh::load_with(path, options).map_err(|e| e.to_string())?;
     let scene = mesh.to_scene().map_err(|e| match report.skipped {
-        0 => format!("{path}: {e}"),
-        1 => format!("{path}: {e} (1 element that is not a triangle or polygon was skipped)"),
-        n => format!("{path}: {e} ({n} elements that are not triangles or polygons were skipped)"),
+        0 => format!("{shown}: {e}"),
+        1 => format!("{shown}: {e} (1 element that is not a triangle or polygon was skipped)"),
+        n => format!("{shown}: {e} ({n} elements that are not triangles or polygons were skipped)"),
     })?;
-    let name = Path::new(path).file_name().map_or(path.to_string(), |n| n.to_string_lossy().into_owned());
-    let warning = skipped_warning(path, &report);
+    let name = path.file_name().map_or(shown.to_string(), |n| n.to_string_lossy().into_owned());
+    let warning = skipped_warning(&shown.to_string(), &report);
     Ok((NamedScene::new(name, scene), report, warning))
 }
 
@@ -539,9 +548,10 @@ pub fn warn(warning: &Option<String>) {
 }
 
 /// Writes the primitive-id map (`--prim-map`): CSV `prim,file,<where>`, one row per triangle.
-pub fn write_prim_map(out: &str, scene: &str, report: &LoadReport) -> Result<(), String> {
-    raytrail_cli::write::write_atomically(out, |w| write_sources_csv(w, scene, &report.sources))
-        .map_err(|e| format!("cannot write {out}: {e}"))
+pub fn write_prim_map(out: &Path, scene: &Path, report: &LoadReport) -> Result<(), String> {
+    let scene = scene.display().to_string();
+    raytrail_cli::write::write_atomically(out, |w| write_sources_csv(w, &scene, &report.sources))
+        .map_err(|e| format!("cannot write {}: {e}", out.display()))
 }
 
 #[cfg(test)]
@@ -585,7 +595,7 @@ mod tests {
     #[test]
     fn lenient_load_warns_once_and_strict_fails() {
         let path = scratch("edges.obj", OBJ);
-        let (named, report, warning) = load_scene(&path, &args("").load_options()).unwrap();
+        let (named, report, warning) = load_scene(Path::new(&path), &args("").load_options()).unwrap();
         assert_eq!(named.scene.triangles().len(), 1);
         assert_eq!(report.skipped, 3);
         assert_eq!(
@@ -595,22 +605,22 @@ mod tests {
                  a face with 2 vertices (--strict makes this an error)"
             )
         );
-        let e = load_scene(&path, &args("--strict").load_options()).unwrap_err();
+        let e = load_scene(Path::new(&path), &args("--strict").load_options()).unwrap_err();
         assert_eq!(e, format!("{path}:4: face has 2 vertices; a face needs at least 3"));
         // Nothing skipped: no warning.
         let clean = scratch("clean.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-        assert_eq!(load_scene(&clean, &LoadOptions::default()).unwrap().2, None);
+        assert_eq!(load_scene(Path::new(&clean), &LoadOptions::default()).unwrap().2, None);
     }
 
     #[test]
     fn prim_map_file() {
         let path = scratch("map.obj", OBJ);
         let options = LoadOptions { sources: true, ..LoadOptions::default() };
-        let (_, report, _) = load_scene(&path, &options).unwrap();
+        let (_, report, _) = load_scene(Path::new(&path), &options).unwrap();
         let out = scratch("map.csv", b"");
-        write_prim_map(&out, &path, &report).unwrap();
+        write_prim_map(Path::new(&out), Path::new(&path), &report).unwrap();
         assert_eq!(std::fs::read_to_string(&out).unwrap(), format!("prim,file,line\n0,{path},7\n"));
-        let e = write_prim_map("/nonexistent/dir/map.csv", &path, &report).unwrap_err();
+        let e = write_prim_map(Path::new("/nonexistent/dir/map.csv"), Path::new(&path), &report).unwrap_err();
         assert!(e.starts_with("cannot write /nonexistent/dir/map.csv: "), "{e}");
     }
 

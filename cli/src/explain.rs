@@ -33,13 +33,13 @@ pub fn main(a: ExplainArgs) -> Outcome {
     } else {
         check_image(a.width, a.height, "rays per set", "max-rays", a.max_rays, 48)?;
     }
-    let mut inputs = vec![("scene", a.scene.as_str())];
+    let mut inputs = vec![("scene", a.scene.as_path())];
     inputs.extend(a.rays.as_deref().map(|r| ("rays", r)));
     let outputs: Vec<_> = a.json.as_deref().map(|j| ("json", j)).into_iter().collect();
     check_distinct(&inputs, &outputs)?;
     let view = ViewChoice::from_name(&a.view).map_err(crate::failure::Failure::Usage)?;
     let builder = builder(&a.builder);
-    let (loaded, _) = timed(&format!("loading {}", a.scene), || load_scene(&a.scene, &a.load.load_options()));
+    let (loaded, _) = timed(&format!("loading {}", a.scene.display()), || load_scene(&a.scene, &a.load.load_options()));
     let (named, _, warning) = loaded?;
     warn(&warning);
     let scene = &named.scene;
@@ -53,10 +53,11 @@ pub fn main(a: ExplainArgs) -> Outcome {
             let rays = npy::read_rays(path).map_err(|e| e.to_string())?;
             check_count("rays", rays.len() as u64, "max-rays", a.max_rays, 48)?;
             if rays.is_empty() {
+                let path = path.display();
                 return Err(format!("--rays: {path} holds no rays: there is nothing to choose a method for").into());
             }
             let query = if a.any { Query::Any } else { Query::Closest };
-            vec![RaySet { label: path.clone(), query, rays }]
+            vec![RaySet { label: path.display().to_string(), query, rays }]
         }
         None => generated_sets(&backend, scene, &bvh, view, a.width, a.height)?,
     };
@@ -66,8 +67,9 @@ pub fn main(a: ExplainArgs) -> Outcome {
     print(&named.name, &builder.label(made_by), build_s, &analysis);
     if let Some(path) = &a.json {
         let text = serde_json::to_string_pretty(&to_json(&named.name, &analysis)).map_err(|e| e.to_string())?;
-        write_atomically(path, |w| w.write_all(text.as_bytes())).map_err(|e| format!("cannot write {path}: {e}"))?;
-        errln!("wrote {path}");
+        let shown = path.display();
+        write_atomically(path, |w| w.write_all(text.as_bytes())).map_err(|e| format!("cannot write {shown}: {e}"))?;
+        errln!("wrote {shown}");
     }
     Ok(0)
 }

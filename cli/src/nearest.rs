@@ -36,8 +36,8 @@ pub fn main(a: NearestArgs) -> Outcome {
     let start = std::time::Instant::now();
     let found = backend.nearest_points(&scene, &points, a.radius).map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
-    let out = &a.out;
-    npy::write_nearest(out, &found).map_err(|e| e.to_string())?;
+    let out = a.out.display();
+    npy::write_nearest(&a.out, &found).map_err(|e| e.to_string())?;
     let none = found.iter().filter(|f| f.is_none()).count();
     outln!(
         "{} points, {} without a triangle within {}, {:.2} M points/s, written to {out}",

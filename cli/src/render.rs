@@ -46,7 +46,7 @@ pub fn main(a: RenderArgs) -> Outcome {
             a.mode
         ));
     }
-    let (loaded, _) = timed(&format!("loading {}", a.scene), || load_scene(&a.scene, &a.load.load_options()));
+    let (loaded, _) = timed(&format!("loading {}", a.scene.display()), || load_scene(&a.scene, &a.load.load_options()));
     let (named, _, warning) = loaded?;
     warn(&warning);
     let scene = &named.scene;
@@ -109,7 +109,7 @@ pub fn main(a: RenderArgs) -> Outcome {
         a.mode,
         named.name,
         a.camera,
-        a.out
+        a.out.display()
     );
     Ok(0)
 }
@@ -239,7 +239,7 @@ fn heat_colour(x: f32) -> [u8; 3] {
 }
 
 /// Writes an 8-bit RGB PNG, atomically.
-fn write_png(path: &str, width: u32, height: u32, rgb: &[u8]) -> Result<(), String> {
+fn write_png(path: &std::path::Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), String> {
     write_atomically(path, |w| {
         let mut encoder = png::Encoder::new(w, width, height);
         encoder.set_color(png::ColorType::Rgb);
@@ -248,7 +248,7 @@ fn write_png(path: &str, width: u32, height: u32, rgb: &[u8]) -> Result<(), Stri
         writer.write_image_data(rgb).map_err(std::io::Error::other)?;
         writer.finish().map_err(std::io::Error::other)
     })
-    .map_err(|e| format!("cannot write {path}: {e}"))
+    .map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 #[cfg(test)]

@@ -48,7 +48,7 @@ struct RaySetRun {
 }
 
 pub fn main(a: RunArgs) -> Outcome {
-    let scene_arg = a.scene.as_str();
+    let scene_arg = a.scene.as_path();
     let builder = builder(&a.builder);
     let (width, height) = (a.width, a.height);
     let passes = a.passes as usize;
@@ -61,7 +61,8 @@ pub fn main(a: RunArgs) -> Outcome {
         None => CpuBackend::new(),
     };
 
-    let (loaded, _) = timed(&format!("loading {scene_arg}"), || load_scene(scene_arg, &a.load.load_options()));
+    let (loaded, _) =
+        timed(&format!("loading {}", scene_arg.display()), || load_scene(scene_arg, &a.load.load_options()));
     let (named, _, warning) = loaded?;
     warn(&warning);
     let scene = &named.scene;

@@ -32,18 +32,19 @@ pub fn main(a: TraceArgs) -> Outcome {
     }
     check_input("rays", &a.rays)?;
     check_input("scene", &a.scene)?;
-    let mut outputs = vec![("out", a.out.as_str())];
+    let mut outputs = vec![("out", a.out.as_path())];
     outputs.extend(a.prim_map.as_deref().map(|m| ("prim-map", m)));
-    check_distinct(&[("rays", &a.rays), ("scene", &a.scene)], &outputs)?;
+    check_distinct(&[("rays", a.rays.as_path()), ("scene", a.scene.as_path())], &outputs)?;
     let rays = npy::read_rays(&a.rays).map_err(|e| e.to_string())?;
     check_count("rays", rays.len() as u64, "max-rays", a.max_rays, RAY_AND_HIT_BYTES)?;
-    let scene_path = a.scene.as_str();
+    let scene_path = a.scene.as_path();
     let options = LoadOptions { sources: a.prim_map.is_some(), ..a.load.load_options() };
     let (named, report, warning) = load_scene(scene_path, &options)?;
     warn(&warning);
     if let Some(map) = &a.prim_map {
         if report.sources.len() != named.scene.triangles().len() {
-            return Err(format!("--prim-map: {scene_path} is not a mesh file: there is no source to map to").into());
+            let shown = scene_path.display();
+            return Err(format!("--prim-map: {shown} is not a mesh file: there is no source to map to").into());
         }
         write_prim_map(map, scene_path, &report)?;
     }
@@ -64,8 +65,8 @@ pub fn main(a: TraceArgs) -> Outcome {
     });
     let mut hits = try_vec(rays.len(), Hit::MISS, "hits")?;
     let report = backend.trace(&scene, &rays, &opts, &mut hits).map_err(|e| e.to_string())?;
-    let out = &a.out;
-    npy::write_hits(out, &hits).map_err(|e| e.to_string())?;
+    let out = a.out.display();
+    npy::write_hits(&a.out, &hits).map_err(|e| e.to_string())?;
     let n_hit = hits.iter().filter(|h| h.is_hit()).count();
     outln!(
         "{} rays, {} hits, {} refused, {:.2} Mrays/s ({method}), written to {out}",
@@ -92,8 +93,8 @@ fn all_hits(a: &TraceArgs, scene: &Scene, bvh: Bvh2, rays: &[Ray], backend: &Cpu
     let start = std::time::Instant::now();
     let lists = backend.all_hits(&cpu, rays, &options).map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
-    let out = &a.out;
-    npy::write_hit_lists(out, &lists).map_err(|e| e.to_string())?;
+    let out = a.out.display();
+    npy::write_hit_lists(&a.out, &lists).map_err(|e| e.to_string())?;
     let refused = lists.iter().filter(|l| l.first().is_some_and(Hit::is_refused)).count();
     let truncated = (0..lists.len()).filter(|&i| lists.is_truncated(i)).count();
     let hit = lists.iter().filter(|l| !l.is_empty()).count() - refused;
@@ -132,8 +133,8 @@ pub fn rays_main(a: RaysArgs) -> Outcome {
     } else {
         primary_from(&camera, a.width, a.height)
     };
-    let out = &a.out;
-    npy::write_rays(out, &rays).map_err(|e| e.to_string())?;
+    let out = a.out.display();
+    npy::write_rays(&a.out, &rays).map_err(|e| e.to_string())?;
     outln!("{} primary rays ({} order) written to {out}", rays.len(), a.order);
     Ok(0)
 }

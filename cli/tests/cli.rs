@@ -261,3 +261,36 @@ fn a_mesh_from_a_pipe_is_read_as_a_stream_with_its_format_from_its_content() {
     let out = bin().args(["rays", "--scene", "/dev/zero", "--out"]).arg(tmp("zero.npy")).output().unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("it is a device, not a file or a pipe"));
 }
+
+#[test]
+fn paths_are_taken_as_the_system_has_them_not_only_as_utf8() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tmp("");
+    let named = |bytes: &[u8]| dir.join(OsStr::from_bytes(bytes));
+    let (scene, rays, hits, image) =
+        (named(b"tea\xffpot.obj"), named(b"rays\xfe.npy"), named(b"hits\xfd.npy"), named(b"image\xfc.png"));
+    std::fs::copy(mesh_path("teapot.obj"), &scene).unwrap();
+    let ok = |out: std::process::Output| assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    ok(bin()
+        .args(["rays", "--width", "8", "--height", "6", "--scene"])
+        .arg(&scene)
+        .arg("--out")
+        .arg(&rays)
+        .output()
+        .unwrap());
+    ok(bin().args(["trace", "--scene"]).arg(&scene).arg("--rays").arg(&rays).arg("--out").arg(&hits).output().unwrap());
+    ok(bin()
+        .args(["render", "--width", "8", "--height", "6", "--scene"])
+        .arg(&scene)
+        .arg("--out")
+        .arg(&image)
+        .output()
+        .unwrap());
+    assert_eq!(npy::read_hits(&hits).unwrap().len(), 48);
+    assert!(image.is_file());
+    // An output naming the input is still caught, whatever the bytes of its name.
+    let out =
+        bin().args(["trace", "--scene"]).arg(&scene).arg("--rays").arg(&rays).arg("--out").arg(&rays).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+}

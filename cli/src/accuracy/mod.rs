@@ -36,6 +36,7 @@ use raytrail_cli::write::write_atomically;
 use raytrail_conformance::exact::{ExactAnswer, ExactScene, Tolerance};
 use report::{AccuracyReport, RaySetReport, Row, SceneReport};
 use std::io::Write;
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -143,16 +144,16 @@ pub fn main(a: AccuracyArgs, args: &[String]) -> Outcome {
     let p = plan(&a)?;
     for (flag, path) in [("json", &a.json), ("plot", &a.plot)] {
         if let Some(path) = path {
-            check_output(flag, path)?;
+            check_output(flag, Path::new(path))?;
         }
     }
     for path in &p.scenes {
-        check_input("scene", path)?;
+        check_input("scene", Path::new(path))?;
     }
-    let inputs: Vec<_> = p.scenes.iter().map(|s| ("scene", s.as_str())).collect();
+    let inputs: Vec<_> = p.scenes.iter().map(|s| ("scene", Path::new(s))).collect();
     let outputs: Vec<_> = [("json", &a.json), ("plot", &a.plot)]
         .into_iter()
-        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, p)))
+        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, Path::new(p))))
         .collect();
     check_distinct(&inputs, &outputs)?;
     let pixels = u64::from(p.width) * u64::from(p.height);
@@ -219,7 +220,7 @@ pub fn sample_indices(len: usize, n: usize) -> Vec<usize> {
 
 /// Loads and prepares one scene, and measures every view of it that is kept.
 fn measure_scene(path: &str, p: &Plan) -> Result<Vec<SceneReport>, String> {
-    let (loaded, _) = timed(&format!("loading {path}"), || crate::args::load_scene(path, &p.load));
+    let (loaded, _) = timed(&format!("loading {path}"), || crate::args::load_scene(Path::new(path), &p.load));
     let (named, _, warning) = loaded?;
     crate::args::warn(&warning);
     let scene = &named.scene;

@@ -39,6 +39,7 @@ use raytrail::Builder;
 use raytrail_cli::write::write_atomically;
 use report::{BenchReport, Built, SceneReport};
 use std::io::Write;
+use std::path::Path;
 use std::sync::Arc;
 use target::{BenchTarget, RaytrailCpu, Targets};
 use target_gpu::RaytrailGpu;
@@ -50,18 +51,18 @@ pub fn main(a: options::BenchArgs, args: &[String]) -> Outcome {
     let opts = Options::from_args(&a).map_err(Failure::Usage)?;
     check_baseline(&opts).map_err(Failure::Usage)?;
     if let Some(path) = &opts.json {
-        check_output("json", path)?;
+        check_output("json", Path::new(path))?;
     }
     if let Some(path) = &opts.plot {
-        check_output("plot", path)?;
+        check_output("plot", Path::new(path))?;
     }
     for path in &opts.scenes {
-        check_input("scene", path)?;
+        check_input("scene", Path::new(path))?;
     }
-    let inputs: Vec<_> = opts.scenes.iter().map(|s| ("scene", s.as_str())).collect();
+    let inputs: Vec<_> = opts.scenes.iter().map(|s| ("scene", Path::new(s))).collect();
     let outputs: Vec<_> = [("json", &opts.json), ("plot", &opts.plot)]
         .into_iter()
-        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, p)))
+        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, Path::new(p))))
         .collect();
     check_distinct(&inputs, &outputs)?;
     let pools = opts
@@ -137,7 +138,7 @@ fn bench_scene(
     done: &mut dyn FnMut(&SceneReport),
 ) -> Result<Vec<SceneReport>, String> {
     let options = LoadOptions { strict: opts.strict, ..LoadOptions::default() };
-    let (loaded, _) = timed(&format!("loading {path}"), || crate::args::load_scene(path, &options));
+    let (loaded, _) = timed(&format!("loading {path}"), || crate::args::load_scene(Path::new(path), &options));
     let (named, _, warning) = loaded?;
     crate::args::warn(&warning);
     let scene = &named.scene;
