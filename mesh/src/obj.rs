@@ -244,7 +244,7 @@ fn locate_bad_reference(data: &[u8]) -> Option<(usize, String)> {
     let mut defined = [0i64; 3];
     let mut colored = 0i64;
     for (i, (_, line)) in lines(data).enumerate() {
-        let mut words = words(line);
+        let mut words = tobj_words(line).into_iter();
         match words.next() {
             Some(b"v") => {
                 defined[0] += 1;
@@ -282,6 +282,16 @@ fn locate_bad_reference(data: &[u8]) -> Option<(usize, String)> {
 }
 
 /// Lines as tobj sees them (split at `\n`), with the byte offset where each starts.
+/// The words of a line as tobj splits them: at Unicode whitespace where the line is UTF-8 (a
+/// vertical tab separates words there, not in `u8::is_ascii_whitespace`'s sense: a reference
+/// ending in one was read as no number and escaped the pre-check), at ASCII whitespace otherwise.
+fn tobj_words(line: &[u8]) -> Vec<&[u8]> {
+    match std::str::from_utf8(line) {
+        Ok(text) => text.split_whitespace().map(str::as_bytes).collect(),
+        Err(_) => words(line).collect(),
+    }
+}
+
 fn lines(data: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
     let mut start = 0;
     data.split(|&b| b == b'\n').map(move |line| {
@@ -464,7 +474,10 @@ mod tests {
         // caught, printed a backtrace in debug builds).
         let fuzzed = "| a\nv 0 0 00\nvn 0 00 0\nv0\nvn 0 0 1\nf 1/v00/0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvf 0 1\n\
 f 1/1/1 2/1/  -1 \nf 1/1/1 2/1/1 3/1/-100 0\nvn -2 -3 0 0 1\nf 1/1\nf 1/v0000 0\nvn 0 0 1\nf 1/v0\nf \n1 2 3f 1 2 3";
-        for (text, line) in [(fuzzed, 13), ("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/-9 2/1 3/1\n", 5)] {
+        // The first campaign's crash: a relative normal ending in a vertical tab, a word separator
+        // to tobj but not to `u8::is_ascii_whitespace`, so the pre-check saw no number.
+        let tab = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//-10\x0b\n";
+        for (text, line) in [(fuzzed, 13), ("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/-9 2/1 3/1\n", 5), (tab, 5)] {
             let e = err(text);
             assert!(e.starts_with(&format!("t.obj:{line}: face refers to ")), "{e}");
             assert!(!e.contains("panicked"), "{e}");
