@@ -12,9 +12,9 @@
 //!   `brute-force` over every triangle (on the sphereflake only: it is that slow).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput};
-use raytrail::core::nearest::closest_point_on_triangle;
 use raytrail::core::scene::Scene;
-use raytrail::{AllHitsOptions, Ray, Tracer, TracerBuilder, Vec3};
+use raytrail::{AllHitsOptions, Ray, Tracer, TracerBuilder};
+use raytrail_conformance::nearest::brute_force;
 use raytrail_conformance::paths::{find_mesh, load_mesh_scene};
 use raytrail_conformance::rays::{primary, query_points};
 use raytrail_conformance::scenes::sphereflake;
@@ -79,18 +79,7 @@ fn queries(c: &mut Criterion) {
             let few = &pts[..256];
             group.throughput(Throughput::Elements(few.len() as u64));
             group.bench_function(BenchmarkId::from_parameter("brute-force"), |b| {
-                b.iter(|| {
-                    few.iter()
-                        .map(|p| {
-                            let q = Vec3::from_array(*p);
-                            scene
-                                .triangles()
-                                .iter()
-                                .map(|t| closest_point_on_triangle(q, t.v[0], t.v[1], t.v[2]).distance2)
-                                .fold(f32::INFINITY, f32::min)
-                        })
-                        .sum::<f32>()
-                })
+                b.iter(|| few.iter().filter_map(|p| brute_force(&scene, *p, f32::INFINITY)).count())
             });
         }
         group.finish();

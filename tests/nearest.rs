@@ -2,31 +2,10 @@
 //! every triangle with the same per-triangle rule, within a radius or without one, on scenes of
 //! ordinary size and on one prepared at another scale; errors for bad radii.
 
-use raytrail::core::nearest::closest_point_on_triangle;
-use raytrail::core::scene::Scene;
-use raytrail::{Error, NearestPoint, TracerBuilder, Vec3};
+use raytrail::{Error, TracerBuilder};
+use raytrail_conformance::nearest::brute_force;
 use raytrail_conformance::rays::query_points;
 use raytrail_conformance::scenes::{far_from_origin, shared_edge_grid, sphereflake, triangle_soup};
-
-/// The nearest point to `p` within `radius` over every triangle (ties to the lower id).
-fn brute_force(scene: &Scene, p: [f32; 3], radius: f32) -> Option<NearestPoint> {
-    let q = Vec3::from_array(p);
-    let mut best: Option<(f32, NearestPoint)> = None;
-    for (prim, t) in scene.triangles().iter().enumerate() {
-        let on = closest_point_on_triangle(q, t.v[0], t.v[1], t.v[2]);
-        if on.distance2 <= radius * radius && best.is_none_or(|(d, _)| on.distance2 < d) {
-            let n = NearestPoint {
-                prim: prim as u32,
-                u: on.u,
-                v: on.v,
-                point: on.point.to_array(),
-                distance: on.distance2.sqrt(),
-            };
-            best = Some((on.distance2, n));
-        }
-    }
-    best.map(|(_, n)| n)
-}
 
 #[test]
 fn nearest_points_are_a_brute_force_s_bit_for_bit() {

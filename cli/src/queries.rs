@@ -4,13 +4,12 @@
 //! on a sample; the refit's closest hits against a scene prepared afresh).
 
 use raytrail::core::method::{Bvh2Method, Method};
-use raytrail::core::nearest::closest_point_on_triangle;
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::scene::Scene;
 use raytrail::core::trace::{Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::CpuBackend;
-use raytrail::{AllHitsOptions, Builder, Vec3};
+use raytrail::{AllHitsOptions, Builder};
 use raytrail_conformance::all_hits::brute_force_mismatches;
 use raytrail_conformance::rays::query_points;
 use raytrail_conformance::scenes::breathing;
@@ -56,16 +55,7 @@ pub fn print_queries(
         .iter()
         .zip(&found)
         .step_by(points.len() / SAMPLE)
-        .filter(|(p, f)| {
-            let q = Vec3::from_array(**p);
-            let best = scene
-                .triangles()
-                .iter()
-                .enumerate()
-                .map(|(i, t)| (closest_point_on_triangle(q, t.v[0], t.v[1], t.v[2]).distance2, i as u32))
-                .fold((f32::INFINITY, u32::MAX), |b, x| if x.0 < b.0 { x } else { b });
-            f.map(|f| f.prim) != Some(best.1)
-        })
+        .filter(|(p, f)| **f != raytrail_conformance::nearest::brute_force(scene, **p, f32::INFINITY))
         .count();
     failed += wrong;
     outln!(
