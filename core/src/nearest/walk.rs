@@ -92,7 +92,7 @@ pub fn nearest_point_in<const W: usize, M: WideMemory<W> + ?Sized>(
         }
     }
     // `distance` held the squared distance while searching.
-    best.map(|b| NearestPoint { distance: b.distance.sqrt(), ..b })
+    best.map(|b| NearestPoint { distance: libm::sqrtf(b.distance), ..b })
 }
 
 /// The point of `scene`'s mesh nearest to `p` within `radius` ([`nearest_point_in`] on the
