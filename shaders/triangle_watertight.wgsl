@@ -45,8 +45,14 @@ fn tri_prepare(r: Ray) {
 
 // `p * q - r * s` in f64 rounded to f32, as the CPU's fallback: both products are exact in f64,
 // so contraction cannot change it.
-fn det2_f64(p: f32, q: f32, r: f32, s: f32) -> f32 {
-    return f32(f64(p) * f64(q) - f64(r) * f64(s));
+fn det2_f64(p: f32, q: f32, r: f32, s: f32) -> f64 {
+    return f64(p) * f64(q) - f64(r) * f64(s);
+}
+
+// `intersect::watertight::mixed_signs`: the f64 edge functions are tested before they narrow to
+// f32, where one below the f32 range would become a zero and lose its sign.
+fn mixed_signs_f64(u: f64, v: f64, w: f64) -> bool {
+    return (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
 }
 
 // `intersect::refine::needs_refine`: whether the f32 hit may be more than REFINE_ULPS ulps off, to
@@ -199,9 +205,15 @@ fn tri_intersect(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>, tmin: f32, tmax: f
     var v = opq(ax * cy) - opq(ay * cx);
     var w = opq(bx * ay) - opq(by * ax);
     if u == 0.0 || v == 0.0 || w == 0.0 {
-        u = det2_f64(cx, by, cy, bx);
-        v = det2_f64(ax, cy, ay, cx);
-        w = det2_f64(bx, ay, by, ax);
+        let u64 = det2_f64(cx, by, cy, bx);
+        let v64 = det2_f64(ax, cy, ay, cx);
+        let w64 = det2_f64(bx, ay, by, ax);
+        if mixed_signs_f64(u64, v64, w64) {
+            return no;
+        }
+        u = f32(u64);
+        v = f32(v64);
+        w = f32(w64);
     }
     if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
         return no;

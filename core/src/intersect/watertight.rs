@@ -110,10 +110,11 @@ impl TriangleTest for Watertight {
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
         if u == 0.0 || v == 0.0 || w == 0.0 {
-            let f = |p: f32, q: f32, r: f32, s: f32| (p as f64 * q as f64 - r as f64 * s as f64) as f32;
-            u = f(cx, by, cy, bx);
-            v = f(ax, cy, ay, cx);
-            w = f(bx, ay, by, ax);
+            let [u64, v64, w64] = exact_edges([ax, ay], [bx, by], [cx, cy]);
+            if mixed_signs(u64, v64, w64) {
+                return None;
+            }
+            (u, v, w) = (u64 as f32, v64 as f32, w64 as f32);
         }
         if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
             return None;
@@ -165,6 +166,25 @@ impl TriangleTest for Watertight {
             out
         }
     }
+}
+
+/// The edge functions `u, v, w` of the sheared vertices in `f64`, where the `f32` ones have a
+/// zero: each product of two `f32`s is exact in `f64`, so every sign is that of the exact edge
+/// function of these coordinates (the fallback of Woop, Benthin & Wald 2013 that keeps shared
+/// edges and vertices watertight).
+#[inline(always)]
+fn exact_edges(a: [f32; 2], b: [f32; 2], c: [f32; 2]) -> [f64; 3] {
+    let f = |p: [f32; 2], q: [f32; 2]| f64::from(p[0]) * f64::from(q[1]) - f64::from(p[1]) * f64::from(q[0]);
+    [f(c, b), f(a, c), f(b, a)]
+}
+
+/// Whether the edge functions have both signs (the ray passes outside the triangle). The `f64`
+/// edges are tested before they are narrowed to `f32`: an edge function below the `f32` range
+/// (vertices within about `1e-23` of the ray in a unit-size scene) narrows to a zero and loses its
+/// sign, and a ray outside two triangles then hit them both at a wrong `t`.
+#[inline(always)]
+fn mixed_signs(u: f64, v: f64, w: f64) -> bool {
+    (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)
 }
 
 /// The SSE path of [`Watertight::intersect_block`] (SSE2 is part of the x86_64 baseline).
@@ -283,6 +303,35 @@ mod tests {
         Watertight::intersect(&r, tri[0], tri[1], tri[2], 0.0, f32::INFINITY)
     }
 
+    /// Vertices within about `1e-25` of a ray whose direction is `1e-25` off an axis (a fuzzed
+    /// scene, scaled to unit size): the `f32` edge functions underflow to zeros, and their `f64`
+    /// recomputation, narrowed to `f32`, flushed a negative one to `-0.0`. Both triangles were
+    /// then hit at `t = 0`, where the exact answer misses both (their plane crossings lie outside
+    /// them) and a wide tree, culling the second one's box by its entry at `t = 0.84`, answered
+    /// another triangle than the binary tree.
+    #[test]
+    fn an_edge_function_below_the_f32_range_keeps_its_sign() {
+        let v = |b: [u32; 3]| Vec3::from_array(b.map(f32::from_bits));
+        let o = v([0x1652_5252, 0x82be_be52, 0x82be_bebe]);
+        let d = v([0x82be_bebe, 0x3f7b_7b7b, 0x167b_7b7b]);
+        let near = [
+            [
+                v([0x82be_bebe, 0x3f7b_7b7b, 0x167b_7b7b]),
+                v([0x1652_5252; 3]),
+                v([0x1652_5252, 0x1652_5252, 0x1e52_5252]),
+            ],
+            [
+                v([0x1652_5252; 3]),
+                v([0x1652_5252, 0x3f7b_7b7b, 0x3f5b_7b7b]),
+                v([0x827b_7b7b, 0x82be_bebe, 0x92ce_cece]),
+            ],
+        ];
+        let r = Watertight::prepare(&Ray::new(o, d, -0.37, f32::INFINITY));
+        for [a, b, c] in near {
+            assert_eq!(Watertight::intersect(&r, a, b, c, -0.37, f32::INFINITY), None, "{a} {b} {c}");
+        }
+    }
+
     #[test]
     fn hits_center_with_barycentrics() {
         let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
@@ -339,8 +388,11 @@ mod tests {
         let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
         let (mut u, mut v, mut w) = (cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax);
         if u == 0.0 || v == 0.0 || w == 0.0 {
-            let f = |p: f32, q: f32, r: f32, s: f32| (p as f64 * q as f64 - r as f64 * s as f64) as f32;
-            (u, v, w) = (f(cx, by, cy, bx), f(ax, cy, ay, cx), f(bx, ay, by, ax));
+            let [u64, v64, w64] = exact_edges([ax, ay], [bx, by], [cx, cy]);
+            if mixed_signs(u64, v64, w64) {
+                return None;
+            }
+            (u, v, w) = (u64 as f32, v64 as f32, w64 as f32);
         }
         if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
             return None;
