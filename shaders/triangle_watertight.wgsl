@@ -43,7 +43,7 @@ fn tri_prepare(r: Ray) {
     TR.d = vec3<f32>(r.dir[kx], r.dir[ky], dz);
 }
 
-// `p * q - r * s` in f64 rounded to f32, as the CPU's fallback: both products are exact in f64,
+// `p * q - r * s` in f64, as the CPU's fallback (`exact_edges`): both products are exact in f64,
 // so contraction cannot change it.
 fn det2_f64(p: f32, q: f32, r: f32, s: f32) -> f64 {
     return f64(p) * f64(q) - f64(r) * f64(s);

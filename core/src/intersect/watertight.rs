@@ -116,7 +116,7 @@ impl TriangleTest for Watertight {
             }
             (u, v, w) = (u64 as f32, v64 as f32, w64 as f32);
         }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        if mixed_signs(u, v, w) {
             return None;
         }
         let det = u + v + w;
@@ -178,13 +178,15 @@ fn exact_edges(a: [f32; 2], b: [f32; 2], c: [f32; 2]) -> [f64; 3] {
     [f(c, b), f(a, c), f(b, a)]
 }
 
-/// Whether the edge functions have both signs (the ray passes outside the triangle). The `f64`
-/// edges are tested before they are narrowed to `f32`: an edge function below the `f32` range
-/// (vertices within about `1e-23` of the ray in a unit-size scene) narrows to a zero and loses its
-/// sign, and a ray outside two triangles then hit them both at a wrong `t`.
+/// Whether the edge functions have both signs (the ray passes outside the triangle), in `f32` or
+/// in `f64`. The fallback's `f64` edges are tested before they are narrowed to `f32`: an edge
+/// function below the `f32` range (vertices within about `1e-23` of the ray in a unit-size scene)
+/// narrows to a zero and loses its sign, and a ray outside two triangles then hit them both at a
+/// wrong `t`.
 #[inline(always)]
-fn mixed_signs(u: f64, v: f64, w: f64) -> bool {
-    (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)
+fn mixed_signs<F: PartialOrd + From<f32>>(u: F, v: F, w: F) -> bool {
+    let zero = F::from(0.0);
+    (u < zero || v < zero || w < zero) && (u > zero || v > zero || w > zero)
 }
 
 /// The SSE path of [`Watertight::intersect_block`] (SSE2 is part of the x86_64 baseline).
@@ -394,7 +396,7 @@ mod tests {
             }
             (u, v, w) = (u64 as f32, v64 as f32, w64 as f32);
         }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        if mixed_signs(u, v, w) {
             return None;
         }
         let det = u + v + w;
