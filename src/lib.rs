@@ -17,6 +17,8 @@
 //! [`Tracer`] takes triangles from memory (or a loaded mesh: [`load`]), builds the best tree
 //! and traces batches ([`Tracer::intersect`], [`Tracer::occluded`], and `_into` forms that fill a
 //! caller's slice) on all cores, picking for each large batch the fastest walk of its 8-wide tree.
+//! Meshes placed many times (instances: a 3x4 [`Transform`], an id and a mask each) go to an
+//! [`InstancedTracer`], which builds each mesh's tree once and names the instance of every hit.
 //!
 //! # Which method
 //!
@@ -75,11 +77,15 @@
 #[cfg(feature = "cpu")]
 pub mod analysis;
 mod error;
+#[cfg(feature = "cpu")]
+mod instanced;
 pub mod prelude;
 #[cfg(feature = "cpu")]
 mod tracer;
 
 pub use error::Error;
+#[cfg(feature = "cpu")]
+pub use instanced::{InstancedTracer, INSTANCED_DEFAULT};
 #[cfg(feature = "cpu")]
 pub use tracer::{Tracer, TracerBuilder, AUTO_MIN_RAYS, AUTO_WALKS};
 
@@ -100,6 +106,7 @@ pub use raytrail_wgpu as gpu;
 pub use raytrail_build::Builder;
 pub use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 pub use raytrail_core::glam::Vec3;
+pub use raytrail_core::instance::{Instance, InstanceHit, Transform};
 pub use raytrail_core::method::{Method, Query};
 pub use raytrail_core::nearest::NearestPoint;
 pub use raytrail_core::{Hit, Ray};

@@ -4,9 +4,10 @@
 pub use crate::load;
 pub use crate::{Builder, Error};
 #[cfg(feature = "cpu")]
-pub use crate::{Tracer, TracerBuilder};
+pub use crate::{InstancedTracer, Tracer, TracerBuilder};
 pub use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 pub use raytrail_core::glam::Vec3;
+pub use raytrail_core::instance::{Instance, InstanceHit, Transform};
 pub use raytrail_core::method::{Bvh2Method, KdMethod, Method, Query, StreamMethod, WideMethod};
 pub use raytrail_core::nearest::NearestPoint;
 pub use raytrail_core::prepared::PreparedScene;

@@ -9,8 +9,9 @@
 //! scene is prepared for it alone.
 
 use crate::analysis::sample::choose_among;
-use crate::{Builder, Error};
+use crate::{Builder, Error, InstancedTracer};
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
+use raytrail_core::instance::Instance;
 use raytrail_core::method::{Method, Query, WideMethod};
 use raytrail_core::nearest::NearestPoint;
 use raytrail_core::prepared::PreparedScene;
@@ -39,10 +40,10 @@ pub const AUTO_MIN_RAYS: usize = 1 << 16;
 /// that cannot hit anything. Start from [`Tracer::builder`].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TracerBuilder {
-    tree: Builder,
-    method: Option<Method>,
+    pub(crate) tree: Builder,
+    pub(crate) method: Option<Method>,
     threads: Option<usize>,
-    reject_untraceable: bool,
+    pub(crate) reject_untraceable: bool,
 }
 
 impl TracerBuilder {
@@ -85,12 +86,26 @@ impl TracerBuilder {
         self.build_scene(&mesh.to_scene()?)
     }
 
-    /// A tracer over a validated scene.
-    pub fn build_scene(self, scene: &Scene) -> Result<Tracer, Error> {
-        let backend = match self.threads {
+    /// A tracer over `instances` of `meshes` (an [`Instance`]'s `mesh` indexes `meshes`), each
+    /// mesh's tree built once by this builder's tree builder, every instance traced with its
+    /// method ([`INSTANCED_DEFAULT`](crate::INSTANCED_DEFAULT) unless named; `auto` does not
+    /// apply). Errors name the instance whose mesh index is out of range or whose transform
+    /// cannot be inverted.
+    pub fn build_instanced(self, meshes: &[Scene], instances: &[Instance]) -> Result<InstancedTracer, Error> {
+        InstancedTracer::build(self, meshes, instances)
+    }
+
+    /// The backend on this builder's threads.
+    pub(crate) fn backend(&self) -> Result<CpuBackend, Error> {
+        Ok(match self.threads {
             Some(n) => CpuBackend::with_threads(n).map_err(Error::ThreadPool)?,
             None => CpuBackend::new(),
-        };
+        })
+    }
+
+    /// A tracer over a validated scene.
+    pub fn build_scene(self, scene: &Scene) -> Result<Tracer, Error> {
+        let backend = self.backend()?;
         let bvh = self.tree.build(scene)?;
         let methods: &[Method] = match &self.method {
             Some(m) => std::slice::from_ref(m),

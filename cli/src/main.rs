@@ -14,6 +14,7 @@ mod explain;
 mod failure;
 mod flags;
 mod gpu;
+mod instances;
 mod limits;
 mod median;
 mod nearest;

@@ -55,12 +55,17 @@ const STREAM_NAME: &str = "<stream>";
 pub const HIT_DESCR: &str = "[('t', '<f4'), ('prim', '<u4'), ('u', '<f4'), ('v', '<f4')]";
 /// The `descr` of an all-hits file (`trace --all`): each hit with the index of its ray.
 pub const LISTED_HIT_DESCR: &str = "[('ray', '<u4'), ('t', '<f4'), ('prim', '<u4'), ('u', '<f4'), ('v', '<f4')]";
+/// The `descr` of a hit file of an instanced scene: each hit with its instance's id (a miss has
+/// the id `0xFFFFFFFF`).
+pub const INSTANCE_HIT_DESCR: &str = "[('t', '<f4'), ('prim', '<u4'), ('u', '<f4'), ('v', '<f4'), ('instance', '<u4')]";
 /// Bytes per ray row.
 const RAY_BYTES: usize = 32;
 /// Bytes per hit record.
 const HIT_BYTES: usize = 16;
 /// Bytes per all-hits record.
 const LISTED_HIT_BYTES: usize = 20;
+/// Bytes per instanced hit record.
+const INSTANCE_HIT_BYTES: usize = 20;
 
 /// A failed `.npy` read or write: which file, and what is wrong with it.
 #[derive(Debug)]
@@ -333,6 +338,19 @@ pub fn write_hit_lists(path: impl AsRef<Path>, lists: &raytrail::AllHits) -> Res
             out.extend_from_slice(&hit.prim.to_le_bytes());
             out.extend_from_slice(&hit.u.to_le_bytes());
             out.extend_from_slice(&hit.v.to_le_bytes());
+        })
+    })
+}
+
+/// Writes the hits of an instanced scene to `path` as a `.npy` structured array of shape `(N,)`
+/// with the dtype [`INSTANCE_HIT_DESCR`], atomically as [`write_hits`] does.
+pub fn write_instance_hits(path: impl AsRef<Path>, hits: &[raytrail::InstanceHit]) -> Result<(), NpyError> {
+    write_file(path.as_ref(), |w| {
+        write_header(w, INSTANCE_HIT_DESCR, &[hits.len()])?;
+        write_records(w, hits, INSTANCE_HIT_BYTES, |hit, out| {
+            for word in [hit.t.to_bits(), hit.prim, hit.u.to_bits(), hit.v.to_bits(), hit.instance] {
+                out.extend_from_slice(&word.to_le_bytes());
+            }
         })
     })
 }

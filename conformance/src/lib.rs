@@ -16,6 +16,7 @@
 pub mod all_hits;
 pub mod check;
 pub mod exact;
+pub mod instanced;
 pub mod nearest;
 pub mod paths;
 pub mod rays;

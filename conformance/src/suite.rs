@@ -60,6 +60,9 @@ pub enum Case {
     MeshPloc(&'static str),
     /// The sphereflake's SAH tree refitted twice as its vertices move ([`breathing`]).
     Refit,
+    /// Instances of three generated meshes against their flattened triangles
+    /// ([`crate::instanced`]).
+    Instanced,
 }
 
 /// Runs one case on `backend`; panics with a loud report on any mismatch.
@@ -99,6 +102,7 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
             }
         }
         Case::Refit => check_refit(backend, &generated_scene("sphereflake"), sah, REFIT_RAYS),
+        Case::Instanced => check_instanced(backend),
     }
 }
 
@@ -288,6 +292,22 @@ pub fn refit_mismatches<B: Trace>(
     mismatches
 }
 
+/// The instanced case: [`instanced_mismatches`](crate::instanced::instanced_mismatches) on
+/// [`instanced_case`](crate::instanced::instanced_case); panics with the first disagreements.
+pub fn check_instanced<B: Trace>(backend: &B) {
+    let case = crate::instanced::instanced_case();
+    let wrong = crate::instanced::instanced_mismatches(backend, &case, &case.instances);
+    if !wrong.is_empty() {
+        let first: Vec<&str> = wrong.iter().take(6).map(String::as_str).collect();
+        panic!("\n{} INSTANCED MISMATCHES on {}. First ones:\n{}", wrong.len(), backend.name(), first.join("\n"));
+    }
+    eprintln!(
+        "instanced: {} methods x 2 queries and every mask agree with the flattened triangles on {}",
+        crate::instanced::INSTANCED_METHODS.len(),
+        backend.name()
+    );
+}
+
 /// The loud failure message: how many mismatches, where, and the first ones in full.
 pub fn mismatch_report(scene: &str, backend: &str, checked: usize, mismatches: &[Mismatch]) -> String {
     let mut msg = format!(
@@ -327,6 +347,7 @@ macro_rules! conformance_suite {
             degenerate_stack_needs_and_uses_64_bit_keys => DegenerateStack,
             far_from_origin => FarFromOrigin,
             tiny_cases => TinyCases,
+            instanced => Instanced,
             cornell_box => Mesh("cornell_box.obj"),
             teapot => Mesh("teapot.obj"),
         );

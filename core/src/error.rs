@@ -75,6 +75,13 @@ pub enum Error {
         /// What cannot run it.
         by: &'static str,
     },
+    /// An instance of an instanced scene cannot be placed.
+    InvalidInstance {
+        /// Its position in the list of instances.
+        index: usize,
+        /// What is wrong with it.
+        why: &'static str,
+    },
     /// A parameter is out of its range.
     InvalidParameter {
         /// The parameter.
@@ -118,6 +125,7 @@ impl fmt::Display for Error {
                 write!(f, "method {method} needs {missing}, which the scene was not prepared with")
             }
             Error::Unsupported { method, by } => write!(f, "method {method} is not supported by {by}"),
+            Error::InvalidInstance { index, why } => write!(f, "instance {index}: {why}"),
             Error::InvalidParameter { name, why } => write!(f, "invalid {name}: {why}"),
             #[cfg(feature = "alloc")]
             Error::Device { backend, detail } => write!(f, "{backend} backend: {detail}"),

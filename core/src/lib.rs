@@ -21,6 +21,8 @@ pub mod bvh2;
 pub mod error;
 pub mod geometry;
 pub mod hash;
+#[cfg(feature = "alloc")]
+pub mod instance;
 pub mod intersect;
 pub mod kd;
 pub mod key;

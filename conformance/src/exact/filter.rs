@@ -116,7 +116,11 @@ pub fn filter(ray: &Ray, tri: &Triangle) -> Filtered {
 
 /// The signed distance (in scene units, `f64`) across `ray` from its line to `tri`'s boundary:
 /// measured in the plane perpendicular to the ray's direction, positive where the line passes
-/// inside, negative outside; `None` for a ray parallel to the plane or a degenerate triangle.
+/// inside, negative outside. A triangle seen edge-on (the ray parallel to its plane, or the
+/// triangle degenerate) projects to a segment or a point that no line passes inside: its margin
+/// is minus the line's distance from that segment, so 0 for a ray in the triangle's plane that
+/// crosses it (a rounded copy of that ray, a mapped instance ray for one, may hit it). `None`
+/// only for a zero or non-finite direction.
 /// Across the ray, not in the triangle's plane, because that is where a watertight test errs:
 /// it decides the edges in the ray's own sheared 2D frame (Woop, Benthin & Wald 2013), so its
 /// rounding moves an edge across the ray; a graze stretches that in the plane by `1 / sin`.
@@ -135,11 +139,27 @@ pub fn margin(ray: &Ray, tri: &Triangle) -> Option<f64> {
     let edge = |p: V, q: V| (dot(cross(p, q), u), len(cross(sub(q, p), u)));
     let edges = [edge(b, c), edge(c, a), edge(a, b)];
     let area = edges.iter().map(|e| e.0).sum::<f64>();
-    if area == 0.0 || !area.is_finite() || edges.iter().any(|e| e.1 == 0.0) {
+    if !area.is_finite() {
         return None;
+    }
+    if area == 0.0 || edges.iter().any(|e| e.1 == 0.0) {
+        let flat = |p: V| sub(p, u.map(|x| x * dot(p, u)));
+        let [a, b, c] = [a, b, c].map(flat);
+        let gap =
+            [(a, b), (b, c), (c, a)].map(|(p, q)| segment_distance(p, q)).into_iter().fold(f64::INFINITY, f64::min);
+        return gap.is_finite().then_some(-gap);
     }
     let m = edges.iter().map(|&(s, l)| area.signum() * s / l).fold(f64::INFINITY, f64::min);
     m.is_finite().then_some(m)
+}
+
+/// The distance of the origin from the segment `p`-`q` (a point where they are equal).
+fn segment_distance(p: V, q: V) -> f64 {
+    let pq = sub(q, p);
+    let len2 = dot(pq, pq);
+    let s = if len2 > 0.0 { (-dot(p, pq) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    let x = [p[0] + s * pq[0], p[1] + s * pq[1], p[2] + s * pq[2]];
+    dot(x, x).sqrt()
 }
 
 /// The sine of the angle between `ray` and `tri`'s plane (`|cos|` of the angle with its normal):

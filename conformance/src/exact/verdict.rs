@@ -77,6 +77,14 @@ pub fn plane_t(ray: &Ray, tri: &Triangle) -> f64 {
     dot(n, [a[0] - o[0], a[1] - o[1], a[2] - o[2]]) / dot(n, d)
 }
 
+/// The distance of `ray`'s point at `t` from `tri` (in `f32`, a tolerance's precision).
+fn point_distance(ray: &Ray, tri: &Triangle, t: f64) -> f64 {
+    let at = |i: usize| (f64::from(ray.origin[i]) + t * f64::from(ray.dir[i])) as f32;
+    let p = glam::Vec3::new(at(0), at(1), at(2));
+    let near = raytrail_core::nearest::closest_point_on_triangle(p, tri.v[0], tri.v[1], tri.v[2]);
+    f64::from(near.distance2).sqrt()
+}
+
 /// Judges `hit`, a method's answer for `ray`, against `exact`; `must_hit` for a ray that cannot
 /// miss (from inside a closed mesh).
 pub fn judge(
@@ -119,7 +127,11 @@ pub fn judge(
     }
     let near_p = margin(ray, tri).is_some_and(|m| m >= -tol.delta);
     let pt = plane_t(ray, tri);
-    if !near_p || (pt - t).abs() > tol.t(ray, tri, t) {
+    let window = tol.t(ray, tri, t);
+    // A ray in the triangle's plane crosses it over a stretch of `t` that the plane does not pin
+    // down: there the point at `t` itself must lie on the triangle, within the tolerance.
+    let on_triangle = window.is_finite() || point_distance(ray, tri, t) <= 4.0 * tol.delta + t.abs() / 262_144.0;
+    if !near_p || !on_triangle || (pt - t).abs() > window {
         return Judgement::Disagree(format!(
             "primitive {} at t = {t:e}, which the ray does not meet there; exactly {:?} at {best:e}",
             hit.prim, exact.winners
@@ -178,5 +190,21 @@ mod tests {
         let ray = graze(0.25, 1e-3);
         assert_eq!(verdict(&ray, &tris, 1), Judgement::Exact);
         assert!(matches!(verdict(&ray, &tris, 0), Judgement::Disagree(_)));
+    }
+
+    #[test]
+    fn a_ray_in_a_triangles_plane_may_hit_it_only_where_it_crosses_it() {
+        // The ray runs along y = 0.25 in the plane z = 0 and crosses the triangle for x in
+        // [0, 0.75], t in [2, 2.75]: a rounded copy of the ray may hit it there, nowhere else.
+        let tris = [Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y)];
+        let ray = Ray::new(Vec3::new(-2.0, 0.25, 0.0), Vec3::X, 0.0, f32::INFINITY);
+        let at = |t: f32| Hit { t, prim: 0, u: 0.0, v: 0.0 };
+        let judge_at =
+            |ray: &Ray, t| judge(ray, &tris, &closest_hit(ray, &tris), &at(t), Tolerance::for_scene(1.0), false);
+        assert_eq!(judge_at(&ray, 2.5), Judgement::Near);
+        assert!(matches!(judge_at(&ray, 3.5), Judgement::Disagree(_)));
+        // Parallel to the plane, four times `delta` above it: no rounding brings it there.
+        let above = Ray { origin: [-2.0, 0.25, 4.0 * Tolerance::for_scene(1.0).delta as f32], ..ray };
+        assert!(matches!(judge_at(&above, 2.5), Judgement::Disagree(_)));
     }
 }

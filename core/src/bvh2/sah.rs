@@ -71,7 +71,15 @@ impl SahBuilder {
 
     /// Builds the canonical tree over `triangles` (primitive id = index).
     pub fn build(&self, triangles: &[Triangle]) -> Result<Bvh2, Error> {
-        if triangles.is_empty() {
+        let bounds: Vec<Aabb> = triangles.iter().map(Triangle::bounds).collect();
+        self.build_boxes(&bounds)
+    }
+
+    /// Builds the canonical tree over primitives known by their boxes `bounds` (primitive id =
+    /// index): the tree [`SahBuilder::build`] makes of triangles with these boxes. The top level
+    /// of an instanced scene is built over its instances' world boxes this way.
+    pub fn build_boxes(&self, bounds: &[Aabb]) -> Result<Bvh2, Error> {
+        if bounds.is_empty() {
             return Err(Error::EmptyScene);
         }
         let cfg = SahConfig {
@@ -80,10 +88,9 @@ impl SahBuilder {
             leaf_block: self.config.leaf_block.max(1),
             ..self.config
         };
-        let bounds: Vec<Aabb> = triangles.iter().map(Triangle::bounds).collect();
         let centroids: Vec<Vec3> = bounds.iter().map(Aabb::center).collect();
-        let mut prims: Vec<u32> = (0..triangles.len() as u32).collect();
-        let mut nodes: Vec<Bvh2Node> = Vec::with_capacity(2 * triangles.len());
+        let mut prims: Vec<u32> = (0..bounds.len() as u32).collect();
+        let mut nodes: Vec<Bvh2Node> = Vec::with_capacity(2 * bounds.len());
         nodes.push(Bvh2Node { bounds: Aabb::EMPTY, kind: NodeKind::Leaf { first: 0, count: 0 } });
         let mut todo = alloc::vec![Work { slot: 0, start: 0, end: prims.len(), depth: 0 }];
         let mut bins = alloc::vec![Bin { bounds: Aabb::EMPTY, count: 0 }; cfg.bins];
@@ -101,7 +108,7 @@ impl SahBuilder {
                 continue;
             }
             let leaf_cost = cfg.intersection_cost * cfg.leaf_tests(count as u32);
-            let best = best_binned_split(range, &bounds, &centroids, cbounds, &cfg, &mut bins, &mut right_area);
+            let best = best_binned_split(range, bounds, &centroids, cbounds, &cfg, &mut bins, &mut right_area);
             let parent_area = node_bounds.half_area().max(f32::MIN_POSITIVE);
             let mid = match best {
                 Some((axis, split, cost)) => {

@@ -24,7 +24,7 @@ use crate::stream::{LevelBvh, StreamScene};
 use crate::wide::keyed::{keyed_nodes, WideHashedMemory};
 use crate::wide::traverse::WideRoot;
 use crate::wide::{WideBvh, WideSliceMemory, WideTree};
-use crate::Error;
+use crate::{Aabb, Error};
 use alloc::vec::Vec;
 
 /// A wide tree the scene may hold, or why building it failed.
@@ -268,6 +268,14 @@ impl PreparedScene {
     /// per-ray slack of the BVH2 and wide methods is made from.
     pub fn scene_scale(&self) -> f32 {
         self.bvh.nodes()[0].bounds.max_abs()
+    }
+
+    /// The box of the scene's triangles in the scene's own units (the root box with the
+    /// power-of-two scale undone, exactly).
+    pub fn bounds(&self) -> Aabb {
+        let b = self.bvh.nodes()[0].bounds;
+        let up = |v: glam::Vec3| v.to_array().map(|x| normalize::scale_pow2(x, self.exponent));
+        Aabb::new(up(b.min).into(), up(b.max).into())
     }
 
     /// Where `method` starts.
