@@ -7,6 +7,7 @@
 
 use crate::tracer::TracerBuilder;
 use crate::Error;
+use rayon::prelude::*;
 use raytrail_core::instance::{trace_instanced, Instance, InstanceHit, InstancedReport, InstancedScene};
 use raytrail_core::method::{Method, Query, WideMethod};
 use raytrail_core::prepared::PreparedScene;
@@ -116,10 +117,29 @@ impl InstancedTracer {
         self.occlusion(rays, Some(masks))
     }
 
-    fn occlusion(&self, rays: &[Ray], masks: Option<&[u32]>) -> Result<Vec<bool>, Error> {
+    /// Whether anything blocks each ray into `blocked` (one slot per ray), with masks where
+    /// given; a refused ray is `false` there and counted in the report.
+    pub fn occluded_into(
+        &self,
+        rays: &[Ray],
+        masks: Option<&[u32]>,
+        blocked: &mut [bool],
+    ) -> Result<InstancedReport, Error> {
+        if blocked.len() != rays.len() {
+            return Err(Error::Core(raytrail_core::Error::BufferMismatch { rays: rays.len(), hits: blocked.len() }));
+        }
         let mut hits = vec![InstanceHit::MISS; rays.len()];
-        self.trace(rays, masks, Query::Any, &mut hits)?;
-        Ok(hits.iter().map(InstanceHit::is_hit).collect())
+        let report = self.trace(rays, masks, Query::Any, &mut hits)?;
+        for (b, h) in blocked.iter_mut().zip(&hits) {
+            *b = h.is_hit();
+        }
+        Ok(report)
+    }
+
+    fn occlusion(&self, rays: &[Ray], masks: Option<&[u32]>) -> Result<Vec<bool>, Error> {
+        let mut blocked = vec![false; rays.len()];
+        self.occluded_into(rays, masks, &mut blocked)?;
+        Ok(blocked)
     }
 
     fn trace(
@@ -135,7 +155,44 @@ impl InstancedTracer {
                 return Err(Error::UntraceableRays { count, first });
             }
         }
+        if hits.len() != rays.len() || masks.is_some_and(|m| m.len() != rays.len()) {
+            let other = if hits.len() != rays.len() { hits.len() } else { masks.map_or(0, <[u32]>::len) };
+            return Err(Error::Core(raytrail_core::Error::BufferMismatch { rays: rays.len(), hits: other }));
+        }
         let options = TraceOptions::new(self.method).query(query);
-        Ok(trace_instanced(&self.backend, &self.scene, rays, masks, &options, hits)?)
+        // The top-level walk and the waves are serial per call: chunks of rays run side by side
+        // on the backend's threads (each chunk's per-instance batches still spread over them).
+        let chunk = rays.len().div_ceil(4 * self.backend.threads()).max(MIN_CHUNK_RAYS);
+        let parts = self.backend.install(|| {
+            rays.par_chunks(chunk)
+                .zip(hits.par_chunks_mut(chunk))
+                .enumerate()
+                .map(|(k, (r, h))| {
+                    let m = masks.map(|m| &m[k * chunk..k * chunk + r.len()]);
+                    trace_instanced(&self.backend, &self.scene, r, m, &options, h)
+                })
+                .collect::<Result<Vec<_>, _>>()
+        })?;
+        Ok(merged(parts, self.scene.instances().len()))
     }
+}
+
+/// The fewest rays a chunk of an instanced call holds: below it a chunk's own top-level walk
+/// and per-instance calls cost more than the thread they gain.
+const MIN_CHUNK_RAYS: usize = 1024;
+
+/// The reports of a call's chunks as one.
+fn merged(parts: Vec<InstancedReport>, instances: usize) -> InstancedReport {
+    let mut out = InstancedReport { entered: vec![0; instances], ..Default::default() };
+    for p in parts {
+        out.report.rays += p.report.rays;
+        out.report.refused += p.report.refused;
+        out.report.untraceable += p.report.untraceable;
+        out.backend_seconds += p.backend_seconds;
+        out.waves = out.waves.max(p.waves);
+        for (sum, n) in out.entered.iter_mut().zip(&p.entered) {
+            *sum += n;
+        }
+    }
+    out
 }

@@ -11,6 +11,9 @@
   bool per ray, :meth:`Scene.intersect_all` every hit along each ray (:class:`AllHits`), :meth:`Scene.nearest`
   the nearest point on the mesh to each query point (:class:`Nearest`). All release the GIL and
   run on all cores.
+- :class:`InstancedScene` places meshes many times by affine maps (each tree built once), with
+  ids and masks; its :meth:`InstancedScene.intersect` returns :class:`InstanceHits`
+  ``(t, prim, u, v, instance)``.
 - :mod:`raytrail.trimesh`: ``RayMeshIntersector``, a drop-in for ``mesh.ray`` in trimesh.
 - :mod:`raytrail.dask`: ``intersect`` / ``occluded`` over dask arrays chunked by rows, on
   dask.distributed or any other scheduler.
@@ -19,10 +22,10 @@ A miss has ``prim == -1`` and ``t == inf``; :data:`REFUSED` (-2) marks a ray too
 scene to answer exactly (``t`` NaN). See the package README for the conventions in full.
 """
 
-from ._raytrail import METHODS, REFUSED, Scene, __version__, load
-from ._hits import AllHits, Hits, Nearest
+from ._raytrail import METHODS, REFUSED, InstancedScene, Scene, __version__, load
+from ._hits import AllHits, Hits, InstanceHits, Nearest
 
-__all__ = ["Scene", "Hits", "AllHits", "Nearest", "load", "METHODS", "REFUSED", "__version__", "trimesh", "dask"]
+__all__ = ["Scene", "InstancedScene", "Hits", "InstanceHits", "AllHits", "Nearest", "load", "METHODS", "REFUSED", "__version__", "trimesh", "dask"]
 
 
 def __getattr__(name):

@@ -1,5 +1,5 @@
-"""The result types of :meth:`raytrail.Scene.intersect`, :meth:`raytrail.Scene.intersect_all` and
-:meth:`raytrail.Scene.nearest`."""
+"""The result types of :meth:`raytrail.Scene.intersect`, :meth:`raytrail.Scene.intersect_all`,
+:meth:`raytrail.Scene.nearest` and :meth:`raytrail.InstancedScene.intersect`."""
 
 from typing import NamedTuple
 
@@ -22,6 +22,24 @@ class Hits(NamedTuple):
     prim: np.ndarray
     u: np.ndarray
     v: np.ndarray
+
+
+class InstanceHits(NamedTuple):
+    """The closest hit of each of N rays in an instanced scene (unpack as
+    ``t, prim, u, v, instance = scene.intersect(...)``).
+
+    - ``t``, ``u``, ``v``: as in :class:`Hits`.
+    - ``prim`` (int64): the face hit, an index into the faces of the instance's mesh; ``-1`` for a
+      miss, ``raytrail.REFUSED`` for a ray too far from the scene to answer.
+    - ``instance`` (int64): the id of the instance hit (its entry in ``ids``, by default its
+      position); ``-1`` for a miss or a refusal.
+    """
+
+    t: np.ndarray
+    prim: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    instance: np.ndarray
 
 
 class AllHits(NamedTuple):

@@ -1,12 +1,12 @@
 """Type stubs of the native module raytrail._raytrail."""
 
 import os
-from typing import Optional, Tuple, Union
+from typing import List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
-from ._hits import AllHits, Hits, Nearest
+from ._hits import AllHits, Hits, InstanceHits, Nearest
 
 __version__: str
 #: "auto" and every method name the tracer knows (Scene.intersect's `method`).
@@ -57,6 +57,58 @@ class Scene:
     def faces(self) -> npt.NDArray[np.int64]: ...
     @property
     def threads(self) -> Optional[int]: ...
+    def __len__(self) -> int: ...
+
+_Masks = Union[int, npt.ArrayLike, None]
+
+class InstancedScene:
+    """Meshes placed many times by affine maps, each with an id and a mask (each tree built once)."""
+
+    def __init__(
+        self,
+        meshes: Sequence[Scene],
+        mesh: npt.ArrayLike,
+        transforms: npt.ArrayLike,
+        *,
+        ids: Optional[npt.ArrayLike] = None,
+        masks: Optional[npt.ArrayLike] = None,
+        threads: Optional[int] = None,
+        method: str = "bvh8-sah",
+    ) -> None: ...
+    def intersect(
+        self,
+        origins: npt.ArrayLike,
+        directions: Optional[npt.ArrayLike] = None,
+        tmin: _Bound = None,
+        tmax: _Bound = None,
+        *,
+        masks: _Masks = None,
+    ) -> InstanceHits:
+        """Closest hits: InstanceHits(t, prim, u, v, instance id (-1 miss))."""
+    def occluded(
+        self,
+        origins: npt.ArrayLike,
+        directions: Optional[npt.ArrayLike] = None,
+        tmin: _Bound = None,
+        tmax: _Bound = None,
+        *,
+        masks: _Masks = None,
+    ) -> npt.NDArray[np.bool_]:
+        """Whether anything the ray's mask admits blocks it within [tmin, tmax]."""
+    @property
+    def meshes(self) -> List[Scene]: ...
+    @property
+    def mesh(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def transforms(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def ids(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def masks(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def threads(self) -> Optional[int]: ...
+    @property
+    def method(self) -> str: ...
     def __len__(self) -> int: ...
 
 def load(path: Union[str, "os.PathLike[str]"], *, threads: Optional[int] = None) -> Scene:

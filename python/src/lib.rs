@@ -22,6 +22,8 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
+mod instances;
+
 /// Rays this process has packed into a buffer of its own (every call but the no-copy one):
 /// `_raytrail._packed_rays()`, for the test that the (N, 8) float32 C-contiguous path copies
 /// nothing.
@@ -57,6 +59,20 @@ fn py_err(e: raytrail::Error) -> PyErr {
 
 fn value_error(msg: String) -> PyErr {
     PyValueError::new_err(msg)
+}
+
+/// The names of every method the tracer knows, in `Method::ALL`'s order (without `"auto"`).
+fn method_names() -> Vec<&'static str> {
+    Method::ALL.iter().map(|m| m.name()).collect()
+}
+
+/// The error of an `occluded` call with `refused` rays too far from the scene to answer as a
+/// bool (`intersect` marks them instead).
+fn refused_error(refused: usize) -> PyErr {
+    value_error(format!(
+        "rays: {refused} ray(s) start over about 4e9 times the scene's size away, where no method answers \
+         exactly; intersect() marks them with prim = raytrail.REFUSED"
+    ))
 }
 
 /// `obj` as a NumPy array: an array as it is, anything else through `numpy.asarray` (lists,
@@ -161,6 +177,62 @@ impl<'py> Reals<'py> {
 
 fn borrow<'py, T: numpy::Element>(a: &Bound<'py, PyUntypedArray>, name: &str) -> PyResult<PyReadonlyArrayDyn<'py, T>> {
     a.cast::<PyArrayDyn<T>>()?.try_readonly().map_err(|e| value_error(format!("{name}: {e}")))
+}
+
+/// An integer array read as `i64` or `u64` (the signed or unsigned kind of its dtype), without a
+/// copy where it already is one of those in native byte order and aligned. Rule: indices, ids
+/// and masks are integers, so a float array is a `TypeError` (a silent cast would hide a swapped
+/// argument), and so are booleans.
+enum Ints<'py> {
+    I64(PyReadonlyArrayDyn<'py, i64>),
+    U64(PyReadonlyArrayDyn<'py, u64>),
+}
+
+impl<'py> Ints<'py> {
+    /// `a` as integers; `what` says what its values are, for the `TypeError` of another dtype.
+    fn new(a: Bound<'py, PyUntypedArray>, name: &str, what: &str) -> PyResult<Self> {
+        let py = a.py();
+        let dt = a.dtype();
+        let aligned = unsafe { (*a.as_array_ptr()).flags & npyffi::NPY_ARRAY_ALIGNED != 0 };
+        let as_kind =
+            |a: Bound<'py, PyUntypedArray>, native: bool, kind: &str| -> PyResult<Bound<'py, PyUntypedArray>> {
+                if native && aligned {
+                    Ok(a)
+                } else {
+                    Ok(a.call_method1("astype", (kind,))?.cast_into::<PyUntypedArray>()?)
+                }
+            };
+        match dt.kind() {
+            // An empty list reaches here as an empty float64 array: it holds no non-integer.
+            b'f' if a.len() == 0 => Ok(Ints::I64(borrow(&as_kind(a, false, "int64")?, name)?)),
+            b'i' => Ok(Ints::I64(borrow(&as_kind(a, dt.is_equiv_to(&dtype::<i64>(py)), "int64")?, name)?)),
+            b'u' => Ok(Ints::U64(borrow(&as_kind(a, dt.is_equiv_to(&dtype::<u64>(py)), "uint64")?, name)?)),
+            _ => Err(PyTypeError::new_err(format!("{name}: expected an integer dtype ({what}), got dtype {dt}"))),
+        }
+    }
+
+    fn shape(&self) -> &[usize] {
+        match self {
+            Ints::I64(a) => a.shape(),
+            Ints::U64(a) => a.shape(),
+        }
+    }
+
+    /// Every value in memory order as `u32`, or a `ValueError` naming the first out of range
+    /// (`{name}[i]`, `i` its flat index; `{name}` alone for a 0-d array).
+    fn to_u32(&self, name: &str, what: &str) -> PyResult<Vec<u32>> {
+        let scalar = self.shape().is_empty();
+        let check = |i: usize, x: i128| {
+            u32::try_from(x).map_err(|_| {
+                let at = if scalar { name.to_string() } else { format!("{name}[{i}]") };
+                value_error(format!("{at} = {x}: out of range; {what} run from 0 to {}", u32::MAX))
+            })
+        };
+        match self {
+            Ints::I64(a) => a.as_array().iter().enumerate().map(|(i, &x)| check(i, i128::from(x))).collect(),
+            Ints::U64(a) => a.as_array().iter().enumerate().map(|(i, &x)| check(i, i128::from(x))).collect(),
+        }
+    }
 }
 
 fn shape_str(shape: &[usize]) -> String {
@@ -518,10 +590,9 @@ impl Scene {
             return Ok(self.auto.clone());
         }
         let Some(m) = Method::from_name(method) else {
-            let names: Vec<&str> = std::iter::once("auto").chain(Method::ALL.iter().map(|m| m.name())).collect();
             return Err(value_error(format!(
-                "method: unknown method {method:?}; expected one of {}",
-                names.join(", ")
+                "method: unknown method {method:?}; expected one of auto, {}",
+                method_names().join(", ")
             )));
         };
         if let Some((_, t)) = self.lock().iter().find(|(n, _)| *n == m.name()) {
@@ -555,40 +626,25 @@ impl Scene {
 /// float array is a `TypeError` (a silent cast would hide a swapped argument), and a negative
 /// index is an error rather than NumPy's count from the end.
 fn faces_from(obj: &Bound<'_, PyAny>, vertex_count: usize) -> PyResult<Vec<[u32; 3]>> {
-    let py = obj.py();
     let a = as_array(obj, "faces")?;
     if a.len() == 0 {
         return Err(value_error(format!(
             "faces: the mesh is empty ({vertex_count} vertices, 0 faces); a scene needs at least one triangle"
         )));
     }
-    let dt = a.dtype();
     if !matches!(a.shape(), [_, 3]) {
         return Err(value_error(format!("faces: expected shape (M, 3), got {}", shape_str(a.shape()))));
     }
     // Either integer kind is read as its 64-bit form, then each index checked against the vertices.
-    match dt.kind() {
-        b'i' => {
-            let a = if dt.is_equiv_to(&dtype::<i64>(py)) {
-                a
-            } else {
-                a.call_method1("astype", ("int64",))?.cast_into()?
-            };
-            let ro = borrow::<i64>(&a, "faces")?;
+    match Ints::new(a, "faces", "vertex indices")? {
+        Ints::I64(ro) => {
             let v = ro.as_array().into_dimensionality::<Ix2>().expect("checked: two dimensions");
             face_rows(v, |idx| if idx < 0 { Err("negative vertex index") } else { Ok(idx as u64) }, vertex_count)
         }
-        b'u' => {
-            let a = if dt.is_equiv_to(&dtype::<u64>(py)) {
-                a
-            } else {
-                a.call_method1("astype", ("uint64",))?.cast_into()?
-            };
-            let ro = borrow::<u64>(&a, "faces")?;
+        Ints::U64(ro) => {
             let v = ro.as_array().into_dimensionality::<Ix2>().expect("checked: two dimensions");
             face_rows(v, Ok, vertex_count)
         }
-        _ => Err(PyTypeError::new_err(format!("faces: expected an integer dtype (vertex indices), got dtype {dt}"))),
     }
 }
 
@@ -644,6 +700,13 @@ fn vertices_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[f32; 3]>> {
 fn hits_type(py: Python<'_>) -> PyResult<&Bound<'_, PyAny>> {
     static HITS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
     Ok(HITS.get_or_try_init(py, || py.import("raytrail._hits")?.getattr("Hits").map(Bound::unbind))?.bind(py))
+}
+
+fn instance_hits_type(py: Python<'_>) -> PyResult<&Bound<'_, PyAny>> {
+    static INSTANCE_HITS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    Ok(INSTANCE_HITS
+        .get_or_try_init(py, || py.import("raytrail._hits")?.getattr("InstanceHits").map(Bound::unbind))?
+        .bind(py))
 }
 
 fn nearest_type(py: Python<'_>) -> PyResult<&Bound<'_, PyAny>> {
@@ -776,10 +839,7 @@ impl Scene {
             })
             .map_err(py_err)?;
         if refused > 0 {
-            return Err(value_error(format!(
-                "rays: {refused} ray(s) start over about 4e9 times the scene's size away, where no method answers \
-                 exactly; intersect() marks them with prim = raytrail.REFUSED"
-            )));
+            return Err(refused_error(refused));
         }
         Ok(out.into_pyarray(py))
     }
@@ -1023,11 +1083,12 @@ fn _exact_judge(
 fn _raytrail(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add_class::<Scene>()?;
+    m.add_class::<instances::InstancedScene>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(_packed_rays, m)?)?;
     #[cfg(feature = "exact-reference")]
     m.add_function(wrap_pyfunction!(_exact_judge, m)?)?;
-    let names: Vec<&str> = std::iter::once("auto").chain(Method::ALL.iter().map(|m| m.name())).collect();
+    let names: Vec<&str> = std::iter::once("auto").chain(method_names()).collect();
     m.add("METHODS", PyTuple::new(py, names)?)?;
     m.add("REFUSED", REFUSED)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

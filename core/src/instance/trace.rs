@@ -154,14 +154,13 @@ impl Candidates {
                 continue;
             }
             let mask = masks.map_or(u32::MAX, |m| m[r]);
+            let slab = Slab::new(ray);
             found.clear();
             stack.clear();
             stack.push(0);
             while let Some(n) = stack.pop() {
                 let node = &nodes[n as usize];
-                if entry(ray, &node.bounds).is_none() {
-                    continue;
-                }
+                let Some(t_node) = slab.entry(&node.bounds) else { continue };
                 match node.kind {
                     NodeKind::Internal { left, right } => {
                         stack.push(right);
@@ -172,7 +171,10 @@ impl Candidates {
                             if scene.instances()[inst as usize].mask & mask == 0 {
                                 continue;
                             }
-                            if let Some(t) = entry(ray, &scene.world_boxes[inst as usize]) {
+                            // A leaf of one instance has that instance's box: its entry is known.
+                            let t =
+                                if count == 1 { Some(t_node) } else { slab.entry(&scene.world_boxes[inst as usize]) };
+                            if let Some(t) = t {
                                 found.push((t, inst));
                             }
                         }
@@ -191,23 +193,45 @@ impl Candidates {
     }
 }
 
-/// Where `ray` enters `b` over its interval, in `f64` (the slab test of the exact ray, rounded
-/// once per step), or `None` where it misses.
-fn entry(ray: &Ray, b: &Aabb) -> Option<f64> {
-    let (mut lo, mut hi) = (f64::from(ray.tmin), f64::from(ray.tmax));
-    for i in 0..3 {
-        let (o, d) = (f64::from(ray.origin[i]), f64::from(ray.dir[i]));
-        let (bl, bh) = (f64::from(b.min[i]), f64::from(b.max[i]));
-        if d == 0.0 {
-            if o < bl || o > bh {
-                return None;
-            }
-            continue;
+/// A ray in `f64` for the slab test: its origin, the reciprocal of each non-zero direction
+/// component, and its interval.
+struct Slab {
+    origin: [f64; 3],
+    /// `1 / d` per axis; `None` where `d == 0` (the ray is parallel to that axis's slabs).
+    inv: [Option<f64>; 3],
+    tmin: f64,
+    tmax: f64,
+}
+
+impl Slab {
+    fn new(ray: &Ray) -> Self {
+        let d = ray.dir.map(f64::from);
+        Slab {
+            origin: ray.origin.map(f64::from),
+            inv: d.map(|d| (d != 0.0).then(|| 1.0 / d)),
+            tmin: f64::from(ray.tmin),
+            tmax: f64::from(ray.tmax),
         }
-        let (a, c) = ((bl - o) / d, (bh - o) / d);
-        lo = lo.max(a.min(c));
-        hi = hi.min(a.max(c));
     }
-    // A margin of 2^-40 relative: the roundings of the quotients above, generously.
-    (lo <= hi + hi.abs() / 1_099_511_627_776.0).then_some(lo)
+
+    /// Where the ray enters `b` over its interval, or `None` where it misses: the slab test in
+    /// `f64` (each slab distance off the exact one by two roundings at most).
+    fn entry(&self, b: &Aabb) -> Option<f64> {
+        let (mut lo, mut hi) = (self.tmin, self.tmax);
+        for i in 0..3 {
+            let o = self.origin[i];
+            let (bl, bh) = (f64::from(b.min[i]), f64::from(b.max[i]));
+            let Some(inv) = self.inv[i] else {
+                if o < bl || o > bh {
+                    return None;
+                }
+                continue;
+            };
+            let (a, c) = ((bl - o) * inv, (bh - o) * inv);
+            lo = lo.max(a.min(c));
+            hi = hi.min(a.max(c));
+        }
+        // A margin of 2^-40 relative: the roundings above, generously.
+        (lo <= hi + hi.abs() / 1_099_511_627_776.0).then_some(lo)
+    }
 }
