@@ -170,7 +170,7 @@ impl Tracer {
 
     /// Triangles in the scene.
     pub fn triangle_count(&self) -> usize {
-        self.scene.0.bvh.prim_order().len()
+        self.scene.0.bvh.prim_count()
     }
 
     /// The closest hit of each ray ([`Hit::MISS`] where there is none).

@@ -18,8 +18,8 @@ METHODS: stack, stack-disjoint, parent-sibling, uncle, hash, hash-disjoint, hash
          bvh8-sah-lists (wide BVH; bvh8-stream and bvh8-sah-stream, the lists' former names, still
          work);
          stream (ray stream, Garanzha & Loop);
-         auto (trace's default; bench --methods): the fastest of bvh8, bvh8-packet, kd-stack, stack
-         and stream
+         auto (trace's default; bench --methods): the fastest of bvh8-sah, bvh8-sah-packet,
+         bvh8-sah-lists, bvh8-packet, bvh8-lists and kd-stack
          timed on a sample of the rays (`raytrail explain SCENE` shows the choice per ray type)
 SCENES:  OBJ, PLY (ASCII or binary), OFF, STL (ASCII or binary), glTF 2.0 (.gltf, .glb), any of them
          gzip-compressed; `builtin` is a generated sphereflake. Elements that are not triangles or

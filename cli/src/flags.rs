@@ -53,7 +53,8 @@ impl LoadFlags {
 }
 
 /// The BVH2 builders by command-line name.
-pub const BUILDERS: [&str; 3] = [Builder::ALL[0].name(), Builder::ALL[1].name(), Builder::ALL[2].name()];
+pub const BUILDERS: [&str; 4] =
+    [Builder::ALL[0].name(), Builder::ALL[1].name(), Builder::ALL[2].name(), Builder::ALL[3].name()];
 
 /// The name that asks for the method to be chosen by timing candidates on a sample of the rays
 /// (`raytrail::analysis`).

@@ -31,7 +31,9 @@ fn framed_triangles(prepared: &PreparedScene) -> Vec<(u32, Triangle)> {
     };
     let mut out: Vec<(u32, Triangle)> =
         prims.iter().zip(tris).filter(|(&p, _)| p != u32::MAX).map(|(&p, &t)| (p, t)).collect();
+    // A triangle a spatial split cut lies in several leaves, the same triangle in each.
     out.sort_by_key(|(p, _)| *p);
+    out.dedup_by_key(|(p, _)| *p);
     out
 }
 

@@ -22,10 +22,11 @@ pub enum Difference {
         /// Whether the method did.
         got: bool,
     },
-    /// A stream method's packet leaf list lacks the leaf holding the ray's reference closest hit.
+    /// A stream method's packet leaf list lacks every leaf holding the ray's reference closest hit.
     IncompleteLeafList {
-        /// The leaf (canonical id) that holds the reference hit.
-        leaf: u32,
+        /// The leaves (canonical ids) that hold the reference hit's triangle: one, or several
+        /// where the tree splits references.
+        leaves: Vec<u32>,
         /// The ray's enumeration: its packet, then the packet's leaves.
         got: Vec<u32>,
     },
@@ -124,8 +125,8 @@ impl fmt::Display for Mismatch {
             Difference::Count { what, expected, got } => {
                 writeln!(f, "    the batch has {expected} {what} rays, the report counts {got}")
             }
-            Difference::IncompleteLeafList { leaf, got } => {
-                writeln!(f, "    the reference hit is in leaf {leaf}, which the packet's leaf list lacks:")?;
+            Difference::IncompleteLeafList { leaves, got } => {
+                writeln!(f, "    the reference hit's triangle is in leaves {leaves:?}, none of which the packet's leaf list has:")?;
                 write_seq(f, self.method.name(), got, 0)
             }
             Difference::Enumeration { expected, got } => {
@@ -352,24 +353,25 @@ pub fn check_ray_set<B: Trace>(
 }
 
 /// The completeness of a stream method's leaf lists: every ray whose reference closest hit (the
-/// stack method's) lies in leaf `leaf_of_prim[prim]` must have that leaf in its enumeration
-/// (its packet, then the packet's leaves).
+/// stack method's) lies on a triangle of leaves `leaves.of(prim)` must have one of those leaves in
+/// its enumeration (its packet, then the packet's leaves).
 pub fn check_complete(
     ctx: Context<'_>,
     rays: &[Ray],
     method: Method,
     reference: &[Hit],
     enumerations: &[Vec<u32>],
-    leaf_of_prim: &[u32],
+    leaves: &PrimLeaves,
 ) -> Vec<Mismatch> {
     let mut out = Vec::new();
     for (i, hit) in reference.iter().enumerate() {
         if !hit.is_hit() {
             continue;
         }
-        let leaf = leaf_of_prim.get(hit.prim as usize).copied().unwrap_or(u32::MAX);
+        let holding = leaves.of(hit.prim);
         let got = enumerations.get(i).map_or(&[][..], Vec::as_slice);
-        if !got.get(1..).unwrap_or(&[]).contains(&leaf) {
+        let listed = got.get(1..).unwrap_or(&[]);
+        if !holding.iter().any(|leaf| listed.contains(leaf)) {
             out.push(Mismatch {
                 scene: ctx.scene.to_string(),
                 ray_set: ctx.ray_set.to_string(),
@@ -379,26 +381,54 @@ pub fn check_complete(
                 query: Query::Closest,
                 ray_index: i,
                 ray: rays[i],
-                difference: Difference::IncompleteLeafList { leaf, got: got.to_vec() },
+                difference: Difference::IncompleteLeafList { leaves: holding.to_vec(), got: got.to_vec() },
             });
         }
     }
     out
 }
 
-/// The canonical id of the leaf holding each primitive of `bvh`.
-pub fn leaf_of_prim(bvh: &raytrail_core::bvh2::Bvh2) -> Vec<u32> {
-    let mut out = vec![u32::MAX; bvh.prim_order().len()];
-    for (id, node) in bvh.nodes().iter().enumerate() {
-        if let raytrail_core::bvh2::NodeKind::Leaf { first, count } = node.kind {
-            for &p in &bvh.prim_order()[first as usize..(first + count) as usize] {
-                if let Some(slot) = out.get_mut(p as usize) {
-                    *slot = id as u32;
+/// The leaves (canonical ids) that reference each primitive of a tree: one per primitive, or
+/// several where the tree splits references.
+#[derive(Clone, Debug)]
+pub struct PrimLeaves {
+    /// Where each primitive's run of `leaves` starts; one more entry closes the last.
+    start: Vec<u32>,
+    leaves: Vec<u32>,
+}
+
+impl PrimLeaves {
+    /// The leaves of every primitive of `bvh`.
+    pub fn new(bvh: &raytrail_core::bvh2::Bvh2) -> PrimLeaves {
+        let order = bvh.prim_order();
+        let mut start = vec![0u32; bvh.prim_count() + 1];
+        for &p in order {
+            start[p as usize + 1] += 1;
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut fill = start.clone();
+        let mut leaves = vec![u32::MAX; order.len()];
+        for (id, node) in bvh.nodes().iter().enumerate() {
+            if let raytrail_core::bvh2::NodeKind::Leaf { first, count } = node.kind {
+                for &p in &order[first as usize..(first + count) as usize] {
+                    leaves[fill[p as usize] as usize] = id as u32;
+                    fill[p as usize] += 1;
                 }
             }
         }
+        PrimLeaves { start, leaves }
     }
-    out
+
+    /// The leaves that reference primitive `prim` (none for an id the tree does not have).
+    pub fn of(&self, prim: u32) -> &[u32] {
+        let p = prim as usize;
+        match (self.start.get(p), self.start.get(p + 1)) {
+            (Some(&a), Some(&b)) => &self.leaves[a as usize..b as usize],
+            _ => &[],
+        }
+    }
 }
 
 #[cfg(test)]

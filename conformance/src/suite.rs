@@ -8,12 +8,12 @@
 //! the [`SerialBackend`] ([`compare_backends`](crate::check::compare_backends)). A method the
 //! backend does not support fails the case: the suite never passes over a method in silence.
 
-use crate::check::{check_against, check_complete, compare_hits, leaf_of_prim, trace_all, Context, Mismatch};
+use crate::check::{check_against, check_complete, compare_hits, trace_all, Context, Mismatch, PrimLeaves};
 use crate::paths::{find_mesh, load_mesh_scene};
 use crate::rays::{ray_sets, RaySetSize};
 use crate::reference::SerialBackend;
 use crate::scenes::{breathing, generated, tiny_cases, NamedScene};
-use raytrail_core::bvh2::{Bvh2, SahBuilder};
+use raytrail_core::bvh2::{Bvh2, SahBuilder, SbvhBuilder};
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Bvh2Method, Method, Query, WideMethod};
 use raytrail_core::prepared::PreparedScene;
@@ -44,9 +44,9 @@ pub const TINY_RAYS: RaySetSize = RaySetSize { width: 16, height: 16, uniform_co
 pub enum Case {
     /// A grid of triangles sharing edges (SAH tree).
     SharedEdgeGrid,
-    /// The sphereflake, with SAH and PLOC trees.
+    /// The sphereflake, with SAH, PLOC and SBVH trees.
     Sphereflake,
-    /// A random triangle soup, with SAH and PLOC trees.
+    /// A random triangle soup, with SAH, PLOC and SBVH trees.
     TriangleSoup,
     /// A stack of triangles deep enough to need 64-bit keys.
     DegenerateStack,
@@ -58,7 +58,9 @@ pub enum Case {
     Mesh(&'static str),
     /// A mesh of the scenes folder with a PLOC tree.
     MeshPloc(&'static str),
-    /// The sphereflake's SAH tree refitted twice as its vertices move ([`breathing`]).
+    /// A mesh of the scenes folder with a tree of spatial splits (SBVH).
+    MeshSbvh(&'static str),
+    /// The sphereflake's SAH and SBVH trees refitted twice as its vertices move ([`breathing`]).
     Refit,
     /// Instances of three generated meshes against their flattened triangles
     /// ([`crate::instanced`]).
@@ -69,12 +71,20 @@ pub enum Case {
 pub fn run_case<B: Trace>(backend: &B, case: Case) {
     let sah = |s: &NamedScene| SahBuilder::default().build(s.scene.triangles()).expect("SAH build");
     let ploc = |s: &NamedScene| raytrail_build::ploc::build_ploc(s.scene.triangles(), 63).expect("PLOC build");
+    // Spatial splits reference a cut triangle from leaves on both sides of the plane: the suite
+    // checks that every method still finds each hit once, in whichever leaf it meets it first.
+    let sbvh = |s: &NamedScene| {
+        let bvh = SbvhBuilder::default().build(s.scene.triangles()).expect("SBVH build");
+        assert!(bvh.has_split_references(), "{}: the SBVH case should cut triangles", s.name);
+        bvh
+    };
     match case {
         Case::SharedEdgeGrid => check_scene(backend, &generated_scene("shared_edge_grid"), sah, GENERATED_RAYS),
         Case::Sphereflake | Case::TriangleSoup => {
             let s = generated_scene(if case == Case::Sphereflake { "sphereflake" } else { "triangle_soup" });
             check_scene(backend, &s, sah, GENERATED_RAYS);
             check_scene(backend, &s, ploc, GENERATED_RAYS);
+            check_scene(backend, &s, sbvh, GENERATED_RAYS);
         }
         Case::DegenerateStack => {
             let s = generated_scene("degenerate_stack");
@@ -101,7 +111,17 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
                 check_scene(backend, &s, ploc, MESH_RAYS);
             }
         }
-        Case::Refit => check_refit(backend, &generated_scene("sphereflake"), sah, REFIT_RAYS),
+        Case::MeshSbvh(file) => {
+            if let Some(s) = mesh(file) {
+                check_scene(backend, &s, sbvh, MESH_RAYS);
+            }
+        }
+        Case::Refit => {
+            let s = generated_scene("sphereflake");
+            check_refit(backend, &s, sah, REFIT_RAYS);
+            // A split tree refits to whole triangles' boxes: its clipped boxes do not survive.
+            check_refit(backend, &s, sbvh, REFIT_RAYS);
+        }
         Case::Instanced => check_instanced(backend),
     }
 }
@@ -199,7 +219,7 @@ pub fn check_prepared<B: Trace>(backend: &B, named: &NamedScene, prepared: Arc<P
     let sets = ray_sets(&named.scene, size, &mut trace_closest);
     let mut mismatches: Vec<Mismatch> = Vec::new();
     let mut checked = 0;
-    let leaves = leaf_of_prim(&serial_scene.bvh);
+    let leaves = PrimLeaves::new(&serial_scene.bvh);
     for set in &sets {
         let ctx = Context { scene: &named.name, ray_set: set.kind.name(), backend: backend.name() };
         mismatches.extend(
@@ -325,8 +345,8 @@ pub fn mismatch_report(scene: &str, backend: &str, checked: usize, mismatches: &
 /// `conformance_suite!(CpuBackend::new());`, or with `try` for a constructor returning a
 /// `Result` (a backend is then made once for each test running at once and kept for the tests
 /// after it, and skipped if it cannot be made unless [`REQUIRE_GPU`] is 1: [`run_case_or_skip`]). `small: try ...` defines only the cases that reach every kernel
-/// and both key widths without the large meshes (generated scenes, the Cornell box and the
-/// teapot), for a second configuration of a backend whose every kernel the full suite already
+/// and both key widths without the large meshes (generated scenes, with SAH, PLOC and SBVH trees,
+/// the Cornell box and the teapot), for a second configuration of a backend whose every kernel the full suite already
 /// ran on every mesh.
 #[macro_export]
 macro_rules! conformance_suite {
@@ -361,6 +381,8 @@ macro_rules! conformance_suite {
             dragon_res2 => Mesh("dragon_vrip_res2.ply.gz"),
             dragon_full => Mesh("dragon_vrip.ply.gz"),
             bunny_with_ploc => MeshPloc("bunny.obj"),
+            cornell_box_with_sbvh => MeshSbvh("cornell_box.obj"),
+            sponza_with_sbvh => MeshSbvh("sponza.obj"),
             refit_sphereflake => Refit,
         );
     };

@@ -2,7 +2,7 @@
 //! the suite's checks (closest hits against the stack method's, and the completeness of the
 //! packets' leaf lists) must catch it, whichever of the six planes is flipped.
 
-use raytrail_conformance::check::{check_complete, leaf_of_prim, Context};
+use raytrail_conformance::check::{check_complete, Context, PrimLeaves};
 use raytrail_conformance::rays::{ray_sets, RaySetSize};
 use raytrail_conformance::suite::generated_scene;
 use raytrail_conformance::SerialBackend;
@@ -90,7 +90,7 @@ fn caught<const K: usize>() -> usize {
     };
     let sets = ray_sets(&named.scene, RaySetSize { width: 48, height: 36, uniform_count: 2048 }, &mut closest);
     let scene = prepared.stream_scene(StreamMethod::Frustum8).expect("stream scene");
-    let leaves = leaf_of_prim(&prepared.bvh);
+    let leaves = PrimLeaves::new(&prepared.bvh);
     let mut found = 0;
     for set in &sets {
         let reference = closest(&set.rays);

@@ -4,7 +4,7 @@
 //! the same occlusion), the CPU backend's enumerations equal the serial reference's, and every
 //! packet's leaf list holds the leaf of each of its rays' closest hits.
 
-use raytrail_conformance::check::{check_complete, leaf_of_prim, Context};
+use raytrail_conformance::check::{check_complete, Context, PrimLeaves};
 use raytrail_conformance::rays::{ray_sets, RaySetSize};
 use raytrail_conformance::suite::generated_scene;
 use raytrail_conformance::SerialBackend;
@@ -56,7 +56,7 @@ fn check(scene_name: &str) {
     };
     let mut closest = |rays: &[Ray]| trace(&serial, rays, TraceOptions::new(Bvh2Method::Stack)).0;
     let sets = ray_sets(&named.scene, RaySetSize { width: 40, height: 30, uniform_count: 1500 }, &mut closest);
-    let leaves = leaf_of_prim(&prepared.bvh);
+    let leaves = PrimLeaves::new(&prepared.bvh);
     for params in settings() {
         for set in &sets {
             for query in Query::ALL {

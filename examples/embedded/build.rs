@@ -257,7 +257,7 @@ fn footprint(p: &PreparedScene, uncles: &BinaryLayout, parents: &BinaryLayout, h
     let warn = |s: String| println!("cargo:warning={s}");
     warn(format!(
         "baked sphereflake({SPHEREFLAKE_DEPTH}): {} triangles, {} internal nodes, {} leaves, depth {}",
-        p.bvh.prim_order().len(),
+        p.bvh.prim_count(),
         s.internal_nodes,
         s.leaves,
         s.depth

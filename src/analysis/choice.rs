@@ -4,22 +4,26 @@
 //! made-up timings and the CPU backend's clock ([`super::sample::CpuClock`]) plugs in for real
 //! runs.
 
-use raytrail_core::method::{Bvh2Method, KdMethod, Method, StreamMethod, WideMethod};
+use raytrail_core::method::{KdMethod, Method, WideMethod};
 use raytrail_core::Error;
 
 /// The methods `auto` chooses among, one per family that was the fastest somewhere in the notes
-/// (`docs/notes/`): the 8-wide tree (most secondary rays, every dragon ray), the same tree walked by
-/// packets (camera rays inside rooms, shadow rays to one light through deep geometry), the kd
-/// stack traversal (primary rays in architectural scenes), the BVH2 stack method (some coherent
-/// shadow rays) and the ray-stream method (coherent primary rays inside rooms). The others each trail one of these
-/// by more than they could gain (bvh4 trails bvh8, kd-short-stack and kd-packet trail or tie
-/// kd-stack, the stackless BVH2 methods tie or trail stack on this CPU).
-pub const CANDIDATES: [Method; 5] = [
-    Method::Wide(WideMethod::BVH8),
+/// (`docs/notes/`): the 8-wide tree of least node area walked by single rays (the cheapest to get
+/// wrong, so first), by packets (camera rays, shadow rays toward one light) and by ray lists
+/// (large batches of incoherent rays, closest or any hit); the pull-up tree by packets and by
+/// ray lists (shadow rays through deep geometry); and the kd stack traversal (ambient occlusion
+/// from outside architectural scenes). The others each trail one of these by more than they
+/// could gain (bvh4 trails bvh8, kd-short-stack and kd-packet trail or tie kd-stack, the BVH2
+/// methods and the ray-stream method trail the wide walks on this CPU; on trees with spatial
+/// splits the single-ray walk of the least-area tree leads the pull-up tree's,
+/// `docs/notes/*-spatial-splits.md`).
+pub const CANDIDATES: [Method; 6] = [
+    Method::Wide(WideMethod::BVH8_SAH),
+    Method::Wide(WideMethod::BVH8_SAH_PACKET),
+    Method::Wide(WideMethod::BVH8_SAH_LISTS),
     Method::Wide(WideMethod::BVH8_PACKET),
+    Method::Wide(WideMethod::BVH8_LISTS),
     Method::Kd(KdMethod::Stack),
-    Method::Bvh2(Bvh2Method::Stack),
-    Method::Stream(StreamMethod::Frustum8),
 ];
 
 /// Timed rounds over the whole sample among the candidates that survive the first look; the
@@ -101,6 +105,9 @@ pub struct Choice {
     pub timed: Vec<Timed>,
     /// Total seconds spent timing (the cost of choosing, beyond preparing the candidates).
     pub cost_seconds: f64,
+    /// The verdict on the list walk of the sample winner's tree, where one was reached
+    /// ([`super::streams::judge`]); `method` is the list walk where it won.
+    pub lists: Option<super::streams::ListsVerdict>,
 }
 
 impl Choice {
@@ -120,10 +127,12 @@ impl Choice {
                 }
             })
             .collect();
-        format!("µs (first look on part of the sample, then median of the rounds): {}", each.join("; "))
+        let check = self.lists.as_ref().map_or(String::new(), |v| format!("; {}", v.summary()));
+        format!("µs (first look on part of the sample, then median of the rounds): {}{check}", each.join("; "))
     }
 
-    /// The chosen method's median seconds on the sample.
+    /// The chosen method's median seconds on the sample (infinite for a list walk, which is not
+    /// timed on it).
     pub fn best_seconds(&self) -> f64 {
         self.timed.iter().find(|t| t.method == self.method).map_or(f64::INFINITY, Timed::median)
     }
@@ -176,7 +185,7 @@ pub fn choose(candidates: &[Method], rounds: usize, clock: &mut dyn SampleClock)
             best = i;
         }
     }
-    Ok(Choice { method: timed[best].method, timed, cost_seconds: cost })
+    Ok(Choice { method: timed[best].method, timed, cost_seconds: cost, lists: None })
 }
 
 /// Marks dropped, and removes from `left`, the candidates whose `time` exceeds `factor` times the
@@ -201,6 +210,7 @@ fn sane(s: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use raytrail_core::method::{Bvh2Method, StreamMethod};
     use std::collections::HashMap;
 
     /// A clock replaying given times per method: the first look's, then the rounds'.
@@ -227,10 +237,10 @@ mod tests {
         }
     }
 
-    const BVH8: Method = CANDIDATES[0];
-    const KD: Method = CANDIDATES[1];
-    const STACK: Method = CANDIDATES[2];
-    const STREAM: Method = CANDIDATES[3];
+    const BVH8: Method = Method::Wide(WideMethod::BVH8);
+    const KD: Method = Method::Kd(KdMethod::Stack);
+    const STACK: Method = Method::Bvh2(Bvh2Method::Stack);
+    const STREAM: Method = Method::Stream(StreamMethod::Frustum8);
 
     #[test]
     fn the_smallest_median_wins_not_the_smallest_single_run() {

@@ -15,6 +15,7 @@ pub mod needs;
 pub mod sample;
 #[cfg(feature = "gpu")]
 pub mod shaders;
+pub mod streams;
 
 use choice::Choice;
 use needs::Needs;

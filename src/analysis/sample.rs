@@ -1,6 +1,7 @@
 //! The sample of a batch that `auto` times its candidates on, and the CPU backend's clock.
 
 use super::choice::{choose, Choice, Portion, SampleClock, CANDIDATES, ROUNDS};
+use super::streams::{self, walks_lists};
 use raytrail_core::method::{Method, Query};
 use raytrail_core::trace::{Trace, TraceOptions};
 use raytrail_core::wide::packet::WIDE_PACKET;
@@ -107,8 +108,9 @@ impl SampleClock for CpuClock<'_> {
 }
 
 /// Chooses among [`CANDIDATES`] (those `scene` holds) for `rays` traced with `query`, timing a
-/// [`sample`] of them on the CPU backend, after one untimed trace. The cost counted in the
-/// choice is every trace's time, that one included.
+/// [`sample`] of them on the CPU backend, after one untimed trace; the list walk of the winner's
+/// tree is then judged on whole streams of the batch ([`streams::judge`]). The cost counted in
+/// the choice is every trace's time, those included.
 ///
 /// Fails with [`Error::NotPrepared`] when the scene holds none of the candidates, and
 /// [`Error::InvalidParameter`] for an empty batch.
@@ -134,13 +136,22 @@ pub fn choose_among(
     if candidates.is_empty() {
         return Err(Error::NotPrepared { method: "auto", missing: "any of its candidate methods' structures" });
     }
+    // A sample cannot judge the list walks (`streams.rs`): they are left out of it and judged
+    // after it, unless nothing else is a candidate.
+    let on_sample: Vec<Method> = candidates.iter().copied().filter(|&m| !walks_lists(m)).collect();
+    let on_sample = if on_sample.is_empty() { candidates.clone() } else { on_sample };
     let sample = sample(rays);
     let mut clock = CpuClock::new(backend, scene, &sample, query);
     // One untimed trace starts the thread pool's workers (the first trace in a process pays for
     // that) so that the first candidate's first round is not judged by it.
-    let warm = clock.seconds(candidates[0], Portion::Part)?;
-    let mut choice = choose(&candidates, ROUNDS, &mut clock)?;
+    let warm = clock.seconds(on_sample[0], Portion::Part)?;
+    let mut choice = choose(&on_sample, ROUNDS, &mut clock)?;
     choice.cost_seconds += warm;
+    if let Some(verdict) = streams::judge(backend, scene, rays, query, choice.method, &candidates)? {
+        choice.cost_seconds += verdict.cost_seconds();
+        choice.method = verdict.method();
+        choice.lists = Some(verdict);
+    }
     Ok(choice)
 }
 

@@ -117,7 +117,7 @@ pub struct BenchArgs {
     /// Also write an SVG plot of the results
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<String>,
-    /// BVH2 builder of raytrail's tree: `best` builds with both and keeps the lower SAH cost
+    /// BVH2 builder of raytrail's tree: `best` builds with `sbvh` and `ploc` and keeps the lower SAH cost
     #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
     /// Ambient-occlusion rays per primary hit (1 to 64)

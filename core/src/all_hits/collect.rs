@@ -77,20 +77,24 @@ impl<'a> HitList<'a> {
     }
 }
 
-/// Sorts `out[start..]` by [`Hit::order`] and, with `merge`, keeps only the first (lowest id) of
-/// each run of equal `t` (`-0.0` equal to `0.0`, as the closest-hit rule has it).
+/// Sorts `out[start..]` by [`Hit::order`], keeps one of each triangle met twice at one `t` (in
+/// two leaves of a tree with split references, bit for bit the same hit) and, with `merge`, only
+/// the first (lowest id) of each run of equal `t` (`-0.0` equal to `0.0`, as the closest-hit rule
+/// has it).
 pub(super) fn sort_and_merge(out: &mut Vec<Hit>, start: usize, merge: bool) {
     out[start..].sort_unstable_by(Hit::order);
-    if merge {
-        let mut kept = start;
-        for i in start..out.len() {
-            if kept == start || out[kept - 1].t != out[i].t {
-                out[kept] = out[i];
-                kept += 1;
-            }
+    let mut kept = start;
+    for i in start..out.len() {
+        let fresh = kept == start || {
+            let last = &out[kept - 1];
+            last.t != out[i].t || (!merge && last.prim != out[i].prim)
+        };
+        if fresh {
+            out[kept] = out[i];
+            kept += 1;
         }
-        out.truncate(kept);
     }
+    out.truncate(kept);
 }
 
 #[cfg(test)]
@@ -124,6 +128,11 @@ mod tests {
         assert_eq!(listed(&hits, 2, true), (alloc::vec![(1.0, 2), (2.0, 4)], true));
         assert_eq!(listed(&[], 0, false), (alloc::vec![], false));
         assert_eq!(listed(&hits, 0, false), (alloc::vec![], true));
+        // A triangle met in two leaves (split references) is listed once, merged or not.
+        let twice = [(2.0, 4), (1.0, 7), (2.0, 4), (2.0, 5)];
+        assert_eq!(listed(&twice, usize::MAX, false).0, alloc::vec![(1.0, 7), (2.0, 4), (2.0, 5)]);
+        assert_eq!(listed(&twice, 2, false), (alloc::vec![(1.0, 7), (2.0, 4)], true));
+        assert_eq!(listed(&twice, usize::MAX, true).0, alloc::vec![(1.0, 7), (2.0, 4)]);
     }
 
     #[test]

@@ -10,8 +10,9 @@
 //!   for a ray as the caller gives it;
 //! - [`AllHits`]: the lists of a batch, one after another.
 //!
-//! Each triangle is in exactly one leaf and each leaf is visited at most once per ray, so no
-//! triangle is reported twice; a ray through an edge two triangles share gets both, as two hits
+//! Each leaf is visited at most once per ray, and a triangle in several leaves (a tree with
+//! spatial splits) gives the same hit in each, which the list keeps once; so no triangle is
+//! reported twice. A ray through an edge two triangles share gets both, as two hits
 //! at one `t` (with [`AllHitsOptions::merge_equal_t`], only the one of the lower primitive id).
 //! A hit is bit for bit what the closest-hit methods would report for that triangle alone, so the
 //! first hit of a list is the ray's closest hit.

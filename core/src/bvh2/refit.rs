@@ -18,7 +18,7 @@ impl Bvh2 {
     ///
     /// [`Error::TreeMismatch`] when the triangle count is not the tree's.
     pub fn refit(&mut self, triangles: &[Triangle]) -> Result<(), Error> {
-        if triangles.len() != self.prim_order().len() {
+        if triangles.len() != self.prim_count() {
             return Err(Error::TreeMismatch {
                 node: 0,
                 why: "refit: the new triangle count differs from the tree's primitive count",

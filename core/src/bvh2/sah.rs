@@ -35,6 +35,16 @@ impl Default for SahConfig {
 }
 
 impl SahConfig {
+    /// The settings a build uses: depth at most 63, at least 2 bins, blocks of at least 1.
+    pub(super) fn normalized(self) -> SahConfig {
+        SahConfig {
+            max_depth: self.max_depth.min(63),
+            bins: self.bins.max(2),
+            leaf_block: self.leaf_block.max(1),
+            ..self
+        }
+    }
+
     /// Leaf tests a leaf of `n` triangles takes: `ceil(n / leaf_block)` (`leaf_block` at least 1).
     #[inline]
     pub fn leaf_tests(&self, n: u32) -> f32 {
@@ -58,9 +68,14 @@ struct Work {
 }
 
 #[derive(Clone, Copy)]
-struct Bin {
+pub(super) struct Bin {
     bounds: Aabb,
     count: u32,
+}
+
+impl Bin {
+    /// A bin holding nothing.
+    pub(super) const EMPTY: Bin = Bin { bounds: Aabb::EMPTY, count: 0 };
 }
 
 impl SahBuilder {
@@ -82,18 +97,13 @@ impl SahBuilder {
         if bounds.is_empty() {
             return Err(Error::EmptyScene);
         }
-        let cfg = SahConfig {
-            max_depth: self.config.max_depth.min(63),
-            bins: self.config.bins.max(2),
-            leaf_block: self.config.leaf_block.max(1),
-            ..self.config
-        };
+        let cfg = self.config.normalized();
         let centroids: Vec<Vec3> = bounds.iter().map(Aabb::center).collect();
         let mut prims: Vec<u32> = (0..bounds.len() as u32).collect();
         let mut nodes: Vec<Bvh2Node> = Vec::with_capacity(2 * bounds.len());
         nodes.push(Bvh2Node { bounds: Aabb::EMPTY, kind: NodeKind::Leaf { first: 0, count: 0 } });
         let mut todo = alloc::vec![Work { slot: 0, start: 0, end: prims.len(), depth: 0 }];
-        let mut bins = alloc::vec![Bin { bounds: Aabb::EMPTY, count: 0 }; cfg.bins];
+        let mut bins = alloc::vec![Bin::EMPTY; cfg.bins];
         let mut right_area = alloc::vec![0.0f32; cfg.bins];
         while let Some(w) = todo.pop() {
             let range = &mut prims[w.start..w.end];
@@ -107,43 +117,16 @@ impl SahBuilder {
                 nodes[w.slot].kind = leaf;
                 continue;
             }
-            let leaf_cost = cfg.intersection_cost * cfg.leaf_tests(count as u32);
             let best = best_binned_split(range, bounds, &centroids, cbounds, &cfg, &mut bins, &mut right_area);
-            let parent_area = node_bounds.half_area().max(f32::MIN_POSITIVE);
+            if keeps_leaf(&cfg, count, node_bounds, best.map(|(_, _, cost)| cost)) {
+                nodes[w.slot].kind = leaf;
+                continue;
+            }
             let mid = match best {
-                Some((axis, split, cost)) => {
-                    let split_cost = cfg.traversal_cost + cfg.intersection_cost * cost / parent_area;
-                    if split_cost >= leaf_cost && count as u32 <= cfg.max_leaf_size {
-                        nodes[w.slot].kind = leaf;
-                        continue;
-                    }
-                    let k = bin_scale(cbounds, axis, cfg.bins);
-                    let mut i = 0;
-                    for j in 0..range.len() {
-                        if bin_of(centroids[range[j] as usize][axis], cbounds.min[axis], k, cfg.bins) < split {
-                            range.swap(i, j);
-                            i += 1;
-                        }
-                    }
-                    i
-                }
-                None if count as u32 <= cfg.max_leaf_size => {
-                    nodes[w.slot].kind = leaf;
-                    continue;
-                }
+                Some((axis, split, _)) => partition_binned(range, &centroids, cbounds, axis, split, cfg.bins),
                 None => 0,
             };
-            let mid = if mid == 0 || mid == count {
-                // Binning could not separate (coincident centroids): median split by centroid on
-                // the widest axis, ties broken by primitive id so the tree is deterministic.
-                let axis = cbounds.extent().max_position();
-                range.sort_unstable_by(|&a, &b| {
-                    centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis]).then(a.cmp(&b))
-                });
-                count / 2
-            } else {
-                mid
-            };
+            let mid = if mid == 0 || mid == count { median_split(range, &centroids, cbounds) } else { mid };
             let left = nodes.len();
             nodes.push(Bvh2Node { bounds: Aabb::EMPTY, kind: leaf });
             nodes.push(Bvh2Node { bounds: Aabb::EMPTY, kind: leaf });
@@ -153,6 +136,69 @@ impl SahBuilder {
         }
         Bvh2::from_nodes(&nodes, 0, prims)
     }
+}
+
+/// Whether a node of `count` primitives in box `node_bounds` stays a leaf, given the unnormalized
+/// cost of its best split (`None`: no split separates it): when the split costs at least the leaf
+/// and the leaf is within [`SahConfig::max_leaf_size`]. `cfg` is normalized (`leaf_block` at
+/// least 1).
+pub(super) fn keeps_leaf(cfg: &SahConfig, count: usize, node_bounds: Aabb, split_cost: Option<f32>) -> bool {
+    if count as u32 > cfg.max_leaf_size {
+        return false;
+    }
+    let leaf_cost = cfg.intersection_cost * cfg.leaf_tests(count as u32);
+    let area = node_bounds.half_area().max(f32::MIN_POSITIVE);
+    split_cost.is_none_or(|c| cfg.traversal_cost + cfg.intersection_cost * c / area >= leaf_cost)
+}
+
+/// Moves the primitives of `range` whose centroid bins below `split` on `axis` to its front;
+/// returns how many there are.
+pub(super) fn partition_binned(
+    range: &mut [u32],
+    centroids: &[Vec3],
+    cbounds: Aabb,
+    axis: usize,
+    split: usize,
+    bins: usize,
+) -> usize {
+    let k = bin_scale(cbounds, axis, bins);
+    let mut i = 0;
+    for j in 0..range.len() {
+        if bin_of(centroids[range[j] as usize][axis], cbounds.min[axis], k, bins) < split {
+            range.swap(i, j);
+            i += 1;
+        }
+    }
+    i
+}
+
+/// The boxes of the two sides [`partition_binned`] would make of `range`, without moving it.
+pub(super) fn binned_sides(
+    range: &[u32],
+    bounds: &[Aabb],
+    centroids: &[Vec3],
+    cbounds: Aabb,
+    axis: usize,
+    split: usize,
+    bins: usize,
+) -> (Aabb, Aabb) {
+    let k = bin_scale(cbounds, axis, bins);
+    range.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(l, r), &p| {
+        if bin_of(centroids[p as usize][axis], cbounds.min[axis], k, bins) < split {
+            (l.union(bounds[p as usize]), r)
+        } else {
+            (l, r.union(bounds[p as usize]))
+        }
+    })
+}
+
+/// Where binning cannot separate (coincident centroids): orders `range` by centroid on the widest
+/// axis of `cbounds`, ties broken by id so the tree is deterministic, and returns the middle.
+pub(super) fn median_split(range: &mut [u32], centroids: &[Vec3], cbounds: Aabb) -> usize {
+    let axis = cbounds.extent().max_position();
+    range
+        .sort_unstable_by(|&a, &b| centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis]).then(a.cmp(&b)));
+    range.len() / 2
 }
 
 #[inline]
@@ -172,7 +218,7 @@ fn bin_of(c: f32, min: f32, scale: f32, bins: usize) -> usize {
 
 /// The best (axis, first bin of the right side, unnormalized cost `A_l T_l + A_r T_r`, `T` the
 /// leaf tests of a side's triangles).
-fn best_binned_split(
+pub(super) fn best_binned_split(
     range: &[u32],
     bounds: &[Aabb],
     centroids: &[Vec3],
@@ -187,7 +233,7 @@ fn best_binned_split(
         if scale == 0.0 || !scale.is_finite() {
             continue;
         }
-        bins.fill(Bin { bounds: Aabb::EMPTY, count: 0 });
+        bins.fill(Bin::EMPTY);
         for &p in range {
             let b = &mut bins[bin_of(centroids[p as usize][axis], cbounds.min[axis], scale, cfg.bins)];
             b.bounds = b.bounds.union(bounds[p as usize]);

@@ -58,6 +58,8 @@ pub struct TreeStats {
 pub struct Bvh2 {
     nodes: Vec<Bvh2Node>,
     prim_order: Vec<u32>,
+    /// Distinct primitives: `prim_order.len()` unless references are split across leaves.
+    prim_count: usize,
     stats: TreeStats,
 }
 
@@ -66,12 +68,37 @@ impl Bvh2 {
     /// pre-order from `root`, and checks the structure: every node reached once, every primitive
     /// referenced once, depth at most 63, sizes within the 2^30 addresses of [`super::NodeRef`].
     pub fn from_nodes(nodes: &[Bvh2Node], root: u32, prim_order: Vec<u32>) -> Result<Bvh2, Error> {
-        if nodes.is_empty() || prim_order.is_empty() {
+        let prim_count = prim_order.len();
+        Self::adopt(nodes, root, prim_order, prim_count, false)
+    }
+
+    /// [`Bvh2::from_nodes`] for a builder with spatial splits: a primitive of `0..prim_count` may
+    /// be referenced by several leaves (each holding the part of it inside its box), at most once
+    /// by each, and must be referenced by one at least.
+    pub fn from_split_nodes(
+        nodes: &[Bvh2Node],
+        root: u32,
+        references: Vec<u32>,
+        prim_count: usize,
+    ) -> Result<Bvh2, Error> {
+        Self::adopt(nodes, root, references, prim_count, true)
+    }
+
+    fn adopt(
+        nodes: &[Bvh2Node],
+        root: u32,
+        prim_order: Vec<u32>,
+        prim_count: usize,
+        split: bool,
+    ) -> Result<Bvh2, Error> {
+        if nodes.is_empty() || prim_order.is_empty() || prim_count == 0 {
             return Err(Error::EmptyScene);
         }
         let mut out: Vec<Bvh2Node> = Vec::with_capacity(nodes.len());
         let mut seen = alloc::vec![false; nodes.len()];
-        let mut prim_seen = alloc::vec![false; prim_order.len()];
+        // The last leaf (new index) referencing each primitive; `u32::MAX` for none yet.
+        let mut last_leaf = alloc::vec![u32::MAX; prim_count];
+        let mut distinct = 0usize;
         let mut new_order: Vec<u32> = Vec::with_capacity(prim_order.len());
         let mut stats =
             TreeStats { internal_nodes: 0, leaves: 0, depth: 0, max_leaf_size: 0, key_width: KeyWidth::W32 };
@@ -112,10 +139,13 @@ impl Bvh2 {
                     }
                     let start = new_order.len() as u32;
                     for &p in range {
-                        let s =
-                            prim_seen.get_mut(p as usize).ok_or(Error::MalformedTree("primitive id out of range"))?;
-                        if core::mem::replace(s, true) {
-                            return Err(Error::MalformedTree("a primitive is referenced twice"));
+                        let last =
+                            last_leaf.get_mut(p as usize).ok_or(Error::MalformedTree("primitive id out of range"))?;
+                        match core::mem::replace(last, new) {
+                            u32::MAX => distinct += 1,
+                            l if l == new => return Err(Error::MalformedTree("a leaf references a primitive twice")),
+                            _ if !split => return Err(Error::MalformedTree("a primitive is referenced twice")),
+                            _ => {}
                         }
                         new_order.push(p);
                     }
@@ -125,42 +155,59 @@ impl Bvh2 {
                 }
             }
         }
-        if new_order.len() != prim_order.len() {
+        if new_order.len() != prim_order.len() || distinct != prim_count {
             return Err(Error::MalformedTree("some primitives are in no leaf"));
         }
         if out.len() >= super::NodeRef::LIMIT as usize {
             return Err(Error::TreeTooLarge { what: "node count", size: out.len() });
         }
         stats.key_width = KeyWidth::for_depth(stats.depth).ok_or(Error::TreeTooDeep { depth: stats.depth, max: 63 })?;
-        Ok(Bvh2 { nodes: out, prim_order: new_order, stats })
+        Ok(Bvh2 { nodes: out, prim_order: new_order, prim_count, stats })
     }
 
-    /// Checks that this tree bounds `triangles`: one primitive id per triangle, every leaf's box
-    /// holding its triangles' boxes and every internal box its children's. A tree built for other
-    /// triangles fails ([`Error::TreeMismatch`]); a tree that passes finds every hit, since no
-    /// triangle lies outside the boxes a ray must enter to reach it. Linear in the tree's size.
+    /// Checks that this tree bounds `triangles`: one primitive id per triangle, every internal
+    /// box holding its children's boxes, and every triangle's box covered by the leaves that
+    /// reference it (the union of each leaf's box cut to the triangle's box is the whole of it;
+    /// for a tree without split references, its one leaf's box holds it). A tree built for other
+    /// triangles fails ([`Error::TreeMismatch`]); a tree that passes without split references
+    /// finds every hit, since no triangle lies outside the boxes a ray must enter to reach it.
+    /// For split references the check is necessary, not sufficient: it bounds the triangle's box,
+    /// not the triangle's every point. Linear in the tree's size.
     pub fn check_bounds(&self, triangles: &[Triangle]) -> Result<(), Error> {
-        if self.prim_order.len() != triangles.len() {
+        if self.prim_count != triangles.len() {
             return Err(Error::TreeMismatch {
                 node: 0,
                 why: "its primitive count differs from the scene's triangle count",
             });
         }
+        // Per primitive: the union of its leaves' boxes cut to its own, and the last such leaf.
+        let mut covered = alloc::vec![(Aabb::EMPTY, 0usize); self.prim_count];
         for (i, node) in self.nodes.iter().enumerate() {
-            let fits = match node.kind {
-                NodeKind::Internal { left, right } => [left, right]
-                    .iter()
-                    .all(|&c| self.nodes.get(c as usize).is_some_and(|child| node.bounds.contains(&child.bounds))),
-                NodeKind::Leaf { first, count } => self.prim_order[first as usize..(first + count) as usize]
-                    .iter()
-                    .all(|&p| triangles.get(p as usize).is_some_and(|t| node.bounds.contains(&t.bounds()))),
-            };
-            if !fits {
-                let why = match node.kind {
-                    NodeKind::Internal { .. } => "its box does not hold a child's box",
-                    NodeKind::Leaf { .. } => "its box does not hold one of its triangles",
-                };
-                return Err(Error::TreeMismatch { node: i, why });
+            match node.kind {
+                NodeKind::Internal { left, right } => {
+                    let fits = [left, right]
+                        .iter()
+                        .all(|&c| self.nodes.get(c as usize).is_some_and(|child| node.bounds.contains(&child.bounds)));
+                    if !fits {
+                        return Err(Error::TreeMismatch { node: i, why: "its box does not hold a child's box" });
+                    }
+                }
+                NodeKind::Leaf { first, count } => {
+                    for &p in &self.prim_order[first as usize..(first + count) as usize] {
+                        let own = triangles[p as usize].bounds();
+                        let cut = Aabb::new(own.min.max(node.bounds.min), own.max.min(node.bounds.max));
+                        let (cover, leaf) = &mut covered[p as usize];
+                        if !cut.is_empty() {
+                            *cover = cover.union(cut);
+                        }
+                        *leaf = i;
+                    }
+                }
+            }
+        }
+        for (p, (cover, leaf)) in covered.iter().enumerate() {
+            if !cover.contains(&triangles[p].bounds()) {
+                return Err(Error::TreeMismatch { node: *leaf, why: "its box does not hold one of its triangles" });
             }
         }
         Ok(())
@@ -177,9 +224,20 @@ impl Bvh2 {
         &self.nodes
     }
 
-    /// Primitive ids in leaf order.
+    /// Primitive ids in leaf order: one entry per reference, so a primitive split across leaves
+    /// appears once in each.
     pub fn prim_order(&self) -> &[u32] {
         &self.prim_order
+    }
+
+    /// Distinct primitives (the scene's triangle count).
+    pub fn prim_count(&self) -> usize {
+        self.prim_count
+    }
+
+    /// Whether some primitive is referenced by more than one leaf (a tree with spatial splits).
+    pub fn has_split_references(&self) -> bool {
+        self.prim_order.len() > self.prim_count
     }
 
     /// Shape figures, including the key width the depth needs.
@@ -221,5 +279,50 @@ impl Bvh2 {
             }
         }
         parents
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// A root over two leaves holding `left` and `right`.
+    fn two_leaves(left: &[u32], right: &[u32]) -> (Vec<Bvh2Node>, Vec<u32>) {
+        let b = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let (l, r) = (left.len() as u32, right.len() as u32);
+        let nodes = alloc::vec![
+            Bvh2Node { bounds: b, kind: NodeKind::Internal { left: 1, right: 2 } },
+            Bvh2Node { bounds: b, kind: NodeKind::Leaf { first: 0, count: l } },
+            Bvh2Node { bounds: b, kind: NodeKind::Leaf { first: l, count: r } },
+        ];
+        (nodes, [left, right].concat())
+    }
+
+    #[test]
+    fn split_references_are_admitted_only_where_asked_and_only_across_leaves() {
+        let (nodes, order) = two_leaves(&[0, 1], &[1, 2]);
+        let err = |e: Result<Bvh2, Error>| e.unwrap_err();
+        assert_eq!(
+            err(Bvh2::from_nodes(&nodes, 0, order.clone())),
+            Error::MalformedTree("a primitive is referenced twice")
+        );
+        let split = Bvh2::from_split_nodes(&nodes, 0, order, 3).unwrap();
+        assert!(split.has_split_references());
+        assert_eq!((split.prim_count(), split.prim_order().len()), (3, 4));
+        let (nodes, order) = two_leaves(&[0, 0], &[1, 2]);
+        assert_eq!(
+            err(Bvh2::from_split_nodes(&nodes, 0, order, 3)),
+            Error::MalformedTree("a leaf references a primitive twice")
+        );
+        let (nodes, order) = two_leaves(&[0, 1], &[1, 0]);
+        assert_eq!(
+            err(Bvh2::from_split_nodes(&nodes, 0, order, 3)),
+            Error::MalformedTree("some primitives are in no leaf")
+        );
+        let (nodes, order) = two_leaves(&[0, 1], &[2, 3]);
+        let whole = Bvh2::from_nodes(&nodes, 0, order).unwrap();
+        assert!(!whole.has_split_references());
+        assert_eq!(whole.prim_count(), 4);
     }
 }

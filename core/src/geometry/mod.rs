@@ -1,6 +1,7 @@
 //! Plain geometric data: rays, boxes, hits and triangles.
 
 mod aabb;
+pub(crate) mod clip;
 mod hit;
 mod ray;
 mod triangle;

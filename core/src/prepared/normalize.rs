@@ -98,7 +98,7 @@ pub fn normalize(scene: &Scene, bvh: Bvh2) -> Result<(Option<Scene>, Bvh2, i32),
         .iter()
         .map(|n| Bvh2Node { bounds: Aabb::new(scale_v(n.bounds.min, k), scale_v(n.bounds.max, k)), kind: n.kind })
         .collect();
-    let scaled_bvh = Bvh2::from_nodes(&nodes, 0, bvh.prim_order().to_vec())?;
+    let scaled_bvh = Bvh2::from_split_nodes(&nodes, 0, bvh.prim_order().to_vec(), bvh.prim_count())?;
     Ok((scaled, scaled_bvh, k))
 }
 

@@ -34,7 +34,7 @@ impl PreparedScene {
     /// [`Error::TreeMismatch`] when `moved` has another triangle count; the scene is then
     /// unchanged. [`PreparedScene::timings`] afterwards holds the refit's times.
     pub fn refit(&mut self, moved: &Scene) -> Result<(), Error> {
-        if moved.triangles().len() != self.bvh.prim_order().len() {
+        if moved.triangles().len() != self.bvh.prim_count() {
             return Err(Error::TreeMismatch {
                 node: 0,
                 why: "refit: the new triangle count differs from the tree's primitive count",

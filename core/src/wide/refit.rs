@@ -24,7 +24,7 @@ impl<const W: usize> WideBvh<W> {
     /// (another node count, or a primitive id past the triangles).
     pub fn refit(&mut self, bvh: &Bvh2, triangles: &[Triangle]) -> Result<(), Error> {
         let mismatch = |why| Error::TreeMismatch { node: 0, why };
-        if triangles.len() != bvh.prim_order().len() {
+        if triangles.len() != bvh.prim_count() {
             return Err(mismatch("refit: the new triangle count differs from the tree's primitive count"));
         }
         let canonical = bvh.nodes();

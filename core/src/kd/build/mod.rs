@@ -26,7 +26,7 @@
 //! (grown by the margin). A node becomes a leaf when it is empty, at the depth cap, when its cell
 //! is flat in two axes, or when no split is cheaper than the leaf.
 
-mod clip;
+use crate::geometry::clip;
 mod sah;
 
 use super::{KdNode, KdTree};

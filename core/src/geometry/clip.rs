@@ -20,7 +20,7 @@ type Vertices = [[f64; 3]; MAX_VERTICES];
 /// outward by far more than its rounding error (a relative `2^-40`), so a triangle that only
 /// touches the box, at a vertex or along an edge, is kept; the bounds are then rounded outward to
 /// `f32` and cut to `cell`.
-pub(super) fn clipped_bounds(tri: &Triangle, tri_bounds: &Aabb, cell: &Aabb) -> Option<Aabb> {
+pub(crate) fn clipped_bounds(tri: &Triangle, tri_bounds: &Aabb, cell: &Aabb) -> Option<Aabb> {
     if misses(tri_bounds, cell) {
         return None;
     }
@@ -38,7 +38,7 @@ pub(super) fn clipped_bounds(tri: &Triangle, tri_bounds: &Aabb, cell: &Aabb) -> 
 /// [`clipped_bounds`] for both children of a split of `cell` on `axis`: the box below (`cell`
 /// with its upper face at `below_max`) and the one above (lower face at `above_min`). The
 /// triangle is clipped to `cell` once, then that polygon against each child's face.
-pub(super) fn split_clipped_bounds(
+pub(crate) fn split_clipped_bounds(
     tri: &Triangle,
     tri_bounds: &Aabb,
     cell: &Aabb,
@@ -58,11 +58,44 @@ pub(super) fn split_clipped_bounds(
         Step::Empty => return (None, None),
         Step::Overflow => return (Some(intersect(*tri_bounds, &below)), Some(intersect(*tri_bounds, &above))),
     }
-    let side = |upper: bool, plane: f32, child: &Aabb| {
-        let plane = if upper { plane as f64 + poly.tol } else { plane as f64 - poly.tol };
-        clipped_polygon_bounds(poly.vertices(), axis, plane, upper, child)
-    };
-    (side(true, below_max, &below), side(false, above_min, &above))
+    split_polygon_bounds(poly.vertices(), poly.tol, axis, below_max, above_min, &below, &above)
+}
+
+/// [`split_clipped_bounds`] without clipping the triangle to `cell` first: the bounds of the
+/// triangle's part on each side of the plane, cut to that side of `cell` (the reference split of
+/// Stich et al. 2009). Conservative as [`split_clipped_bounds`] is, looser where the triangle
+/// leaves `cell` elsewhere, and a few times cheaper: what a builder that splits at many planes
+/// uses.
+pub(crate) fn split_bounds(tri: &Triangle, cell: &Aabb, axis: usize, plane: f32) -> (Option<Aabb>, Option<Aabb>) {
+    let (mut below, mut above) = (*cell, *cell);
+    below.max[axis] = plane;
+    above.min[axis] = plane;
+    let vertices = tri.v.map(|p| [p.x as f64, p.y as f64, p.z as f64]);
+    split_polygon_bounds(&vertices, tolerance(tri, cell), axis, plane, plane, &below, &above)
+}
+
+/// How far clipping planes move outward for `tri` and `cell`: interpolation in `f64` errs by a
+/// few units of `2^-53` relative to the largest magnitude involved; this is `2^-40` of it.
+fn tolerance(tri: &Triangle, cell: &Aabb) -> f64 {
+    let scale = tri.v.iter().fold(cell.max_abs(), |m, v| m.max(v.abs().max_element()));
+    scale as f64 * (1.0 / (1u64 << 40) as f64)
+}
+
+/// The bounds of the parts of polygon `poly` below `below_max` and above `above_min` on `axis`
+/// (planes moved outward by `tol`), cut to the boxes `below` and `above`.
+fn split_polygon_bounds(
+    poly: &[[f64; 3]],
+    tol: f64,
+    axis: usize,
+    below_max: f32,
+    above_min: f32,
+    below: &Aabb,
+    above: &Aabb,
+) -> (Option<Aabb>, Option<Aabb>) {
+    (
+        clipped_polygon_bounds(poly, axis, below_max as f64 + tol, true, below),
+        clipped_polygon_bounds(poly, axis, above_min as f64 - tol, false, above),
+    )
 }
 
 /// Whether boxes `a` and `b` are disjoint (closed boxes: touching is not missing).
@@ -103,13 +136,11 @@ struct Polygon {
 
 impl Polygon {
     fn new(tri: &Triangle, cell: &Aabb) -> Self {
-        let mut scale = cell.max_abs();
         let mut buffers = [[[0.0; 3]; MAX_VERTICES]; 2];
         for (p, v) in buffers[0].iter_mut().zip(tri.v) {
-            scale = scale.max(v.abs().max_element());
             *p = [v.x as f64, v.y as f64, v.z as f64];
         }
-        Self { buffers, current: 0, len: 3, tol: scale as f64 * (1.0 / (1u64 << 40) as f64) }
+        Self { buffers, current: 0, len: 3, tol: tolerance(tri, cell) }
     }
 
     fn vertices(&self) -> &[[f64; 3]] {
@@ -172,24 +203,38 @@ fn clip(
         return Ok(Some(0));
     }
     let mut n = 0;
-    // Walk the edges (prev, cur), starting with the closing edge.
+    inner_part(poly, axis, plane, upper, |p| {
+        *out.get_mut(n).ok_or(Overflow)? = *p;
+        n += 1;
+        Ok(())
+    })?;
+    Ok(Some(n))
+}
+
+/// Hands `emit` the vertices of the part of polygon `poly` on the inner side of the plane (see
+/// [`clip`]), in order: each edge's crossing of the plane, exactly on it along `axis`, and each
+/// vertex inside. Walks the edges (prev, cur), starting with the closing edge.
+fn inner_part(
+    poly: &[[f64; 3]],
+    axis: usize,
+    plane: f64,
+    upper: bool,
+    mut emit: impl FnMut(&[f64; 3]) -> Result<(), Overflow>,
+) -> Result<(), Overflow> {
+    let inside = |p: &[f64; 3]| if upper { p[axis] <= plane } else { p[axis] >= plane };
     let mut prev = &poly[poly.len() - 1];
     let mut prev_in = inside(prev);
     for cur in poly {
         let cur_in = inside(cur);
         if cur_in != prev_in {
-            // The edge crosses the plane: add the crossing, exactly on the plane along `axis`.
-            let p = crossing(prev, cur, axis, plane);
-            *out.get_mut(n).ok_or(Overflow)? = p;
-            n += 1;
+            emit(&crossing(prev, cur, axis, plane))?;
         }
         if cur_in {
-            *out.get_mut(n).ok_or(Overflow)? = *cur;
-            n += 1;
+            emit(cur)?;
         }
         (prev, prev_in) = (cur, cur_in);
     }
-    Ok(Some(n))
+    Ok(())
 }
 
 /// Where the edge `prev`-`cur` crosses the plane, placed exactly on it along `axis`.
@@ -207,44 +252,33 @@ fn crossing(prev: &[f64; 3], cur: &[f64; 3], axis: usize, plane: f64) -> [f64; 3
 /// [`bounds`] of what [`clip`] would give, without storing the polygon; `None` if nothing is
 /// inside.
 fn clipped_polygon_bounds(poly: &[[f64; 3]], axis: usize, plane: f64, upper: bool, cell: &Aabb) -> Option<Aabb> {
-    let inside = |p: &[f64; 3]| if upper { p[axis] <= plane } else { p[axis] >= plane };
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    let mut grow = |p: &[f64; 3]| {
-        for k in 0..3 {
-            // Plain comparisons: no NaN can occur, and `min`/`max` would handle it.
-            lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
-            hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
-        }
-    };
-    let mut prev = &poly[poly.len() - 1];
-    let mut prev_in = inside(prev);
-    for cur in poly {
-        let cur_in = inside(cur);
-        if cur_in != prev_in {
-            let p = crossing(prev, cur, axis, plane);
-            grow(&p);
-        }
-        if cur_in {
-            grow(cur);
-        }
-        (prev, prev_in) = (cur, cur_in);
-    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    // Growing bounds never overflows.
+    let _ = inner_part(poly, axis, plane, upper, |p| {
+        grow_bounds(&mut lo, &mut hi, p);
+        Ok(())
+    });
     (lo[0] <= hi[0]).then(|| rounded_bounds(lo, hi, cell))
 }
 
 /// Bounds of `poly` rounded outward to `f32` and cut to `cell` (the planes were moved outward, so
 /// points may lie just outside it).
 fn bounds(poly: &[[f64; 3]], cell: &Aabb) -> Aabb {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in poly {
-        for k in 0..3 {
-            lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
-            hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
-        }
+        grow_bounds(&mut lo, &mut hi, p);
     }
     rounded_bounds(lo, hi, cell)
+}
+
+/// `[lo, hi]` grown to hold `p`. Plain comparisons: no NaN can occur, and `min`/`max` would
+/// handle it.
+#[inline(always)]
+fn grow_bounds(lo: &mut [f64; 3], hi: &mut [f64; 3], p: &[f64; 3]) {
+    for k in 0..3 {
+        lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
+        hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
+    }
 }
 
 /// `[lo, hi]` rounded outward to `f32` and cut to `cell`.
@@ -260,7 +294,7 @@ fn rounded_bounds(lo: [f64; 3], hi: [f64; 3], cell: &Aabb) -> Aabb {
 }
 
 /// The largest `f32` not above `x`.
-pub(super) fn round_down(x: f64) -> f32 {
+pub(crate) fn round_down(x: f64) -> f32 {
     let f = x as f32;
     if f as f64 > x {
         next_down(f)
@@ -270,7 +304,7 @@ pub(super) fn round_down(x: f64) -> f32 {
 }
 
 /// The smallest `f32` not below `x`.
-pub(super) fn round_up(x: f64) -> f32 {
+pub(crate) fn round_up(x: f64) -> f32 {
     let f = x as f32;
     if (f as f64) < x {
         next_up(f)
@@ -280,7 +314,7 @@ pub(super) fn round_up(x: f64) -> f32 {
 }
 
 /// The next `f32` towards `+inf` (`f32::next_up` needs a newer Rust than the workspace's floor).
-pub(super) fn next_up(x: f32) -> f32 {
+pub(crate) fn next_up(x: f32) -> f32 {
     if x.is_nan() || x == f32::INFINITY {
         return x;
     }
@@ -292,7 +326,7 @@ pub(super) fn next_up(x: f32) -> f32 {
 }
 
 /// The next `f32` towards `-inf`.
-pub(super) fn next_down(x: f32) -> f32 {
+pub(crate) fn next_down(x: f32) -> f32 {
     -next_up(-x)
 }
 
@@ -354,6 +388,23 @@ mod tests {
         // Missing one side.
         let (below, above) = split_clipped_bounds(&t, &t.bounds(), &cell, 1, -0.5, -0.5);
         assert!(below.is_none() && above.is_some());
+    }
+
+    #[test]
+    fn splitting_without_clipping_holds_the_clipped_parts() {
+        let t = tri([0.0, 0.0, 0.0], [4.0, 1.0, 3.0], [1.0, 4.0, -2.0]);
+        let cell = Aabb::new(Vec3::new(0.5, 0.0, -1.0), Vec3::new(3.5, 3.0, 2.0));
+        for plane in [0.75, 1.0, 2.0, 3.25] {
+            let (loose_below, loose_above) = split_bounds(&t, &cell, 0, plane);
+            let (tight_below, tight_above) = split_clipped_bounds(&t, &t.bounds(), &cell, 0, plane, plane);
+            for (loose, tight) in [(loose_below, tight_below), (loose_above, tight_above)] {
+                let (loose, tight) = (loose.unwrap(), tight.unwrap());
+                assert!(loose.contains(&tight), "{loose:?} should hold {tight:?} at {plane}");
+                assert!(cell.contains(&loose));
+            }
+            assert_eq!(loose_below.unwrap().max.x, plane);
+            assert_eq!(loose_above.unwrap().min.x, plane);
+        }
     }
 
     #[test]
