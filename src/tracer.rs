@@ -3,9 +3,10 @@
 //! The tracer owns its tree, so a tree cannot meet the wrong scene. It builds the canonical BVH2
 //! with [`Builder::Best`], collapses it into the 8-wide tree of least node area (Ylitie, Karras &
 //! Laine 2017) and keeps nothing else: every walk it picks from reads that one tree. For a large
-//! batch it times the three walks on a sample of the rays, as `--method auto` does, and traces
-//! the batch with the fastest; a small batch goes ray by ray (what suits rays in no useful
-//! order). A method named with [`TracerBuilder::method`] is used for every batch instead, and the
+//! batch it chooses among the three walks as `--method auto` does (single rays and packets timed
+//! on a sample of the rays, the ray lists on whole streams of the batch: `analysis::streams`),
+//! and traces the batch with the fastest; a small batch goes ray by ray (what suits rays in no
+//! useful order). A method named with [`TracerBuilder::method`] is used for every batch instead, and the
 //! scene is prepared for it alone.
 
 use crate::analysis::sample::choose_among;
