@@ -195,7 +195,7 @@ impl Bvh2 {
                 NodeKind::Leaf { first, count } => {
                     for &p in &self.prim_order[first as usize..(first + count) as usize] {
                         let own = triangles[p as usize].bounds();
-                        let cut = Aabb::new(own.min.max(node.bounds.min), own.max.min(node.bounds.max));
+                        let cut = own.intersection(node.bounds);
                         let (cover, leaf) = &mut covered[p as usize];
                         if !cut.is_empty() {
                             *cover = cover.union(cut);

@@ -24,6 +24,12 @@ impl Aabb {
         Aabb { min: self.min.min(other.min), max: self.max.max(other.max) }
     }
 
+    /// The common part of both boxes: empty ([`Aabb::is_empty`]) where they are disjoint.
+    #[inline]
+    pub fn intersection(self, other: Aabb) -> Aabb {
+        Aabb { min: self.min.max(other.min), max: self.max.min(other.max) }
+    }
+
     /// Smallest box holding this box and a point.
     #[inline]
     pub fn grow(self, p: Vec3) -> Aabb {

@@ -83,7 +83,7 @@ impl SbvhBuilder {
         let mut refs = References::new(&tri_bounds);
         let budget = self.config.max_references_per_triangle.max(1.0);
         let mut spare = ((triangles.len() as f64) * f64::from(budget - 1.0)) as usize;
-        let root = refs.bounds_of(&(0..triangles.len() as u32).collect::<Vec<_>>()).0;
+        let root = tri_bounds.iter().fold(Aabb::EMPTY, |b, &t| b.union(t));
         let min_overlap = self.config.overlap_threshold * root.half_area();
         let mut nodes: Vec<Bvh2Node> = Vec::with_capacity(2 * triangles.len());
         nodes.push(Bvh2Node { bounds: Aabb::EMPTY, kind: NodeKind::Leaf { first: 0, count: 0 } });
@@ -151,7 +151,7 @@ fn emit_leaf(node: &mut Bvh2Node, prim_order: &mut Vec<u32>, ids: &[u32], refs: 
 
 /// The half area of the common part of boxes `a` and `b` (0 where they are disjoint).
 fn overlap(a: Aabb, b: Aabb) -> f32 {
-    let common = Aabb::new(a.min.max(b.min), a.max.min(b.max));
+    let common = a.intersection(b);
     if common.is_empty() {
         0.0
     } else {
