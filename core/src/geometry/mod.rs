@@ -1,6 +1,8 @@
 //! Plain geometric data: rays, boxes, hits and triangles.
 
 mod aabb;
+// Clipping serves only the builders (kd and SBVH), which need the heap.
+#[cfg(feature = "alloc")]
 pub(crate) mod clip;
 mod hit;
 mod ray;
