@@ -1,6 +1,6 @@
 // The watertight ray/triangle test of Woop, Benthin and Wald 2013 (`intersect::Watertight`):
 // the same operations in the same order as the CPU, products fenced by `opq` against contraction,
-// divisions correctly rounded, the f64 fallback for edge functions that come out exactly 0, and
+// divisions correctly rounded, the f64 fallback for edge functions that come out 0 or tiny, and
 // the f64 recomputation of hits whose first-order error bound is too large (core's
 // intersect::refine, operation for operation).
 
@@ -204,12 +204,29 @@ fn tri_intersect(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>, tmin: f32, tmax: f
     var u = opq(cx * by) - opq(cy * bx);
     var v = opq(ax * cy) - opq(ay * cx);
     var w = opq(bx * ay) - opq(by * ax);
-    if u == 0.0 || v == 0.0 || w == 0.0 {
-        let u64 = det2_f64(cx, by, cy, bx);
-        let v64 = det2_f64(ax, cy, ay, cx);
-        let w64 = det2_f64(bx, ay, by, ax);
+    // Whether the first-order error bound applies (not to rescaled edge functions).
+    var bounded = true;
+    let tiny = bitcast<f32>(TINY_EDGE_BITS);
+    if abs_bits(u) < tiny || abs_bits(v) < tiny || abs_bits(w) < tiny {
+        var u64 = det2_f64(cx, by, cy, bx);
+        var v64 = det2_f64(ax, cy, ay, cx);
+        var w64 = det2_f64(bx, ay, by, ax);
         if mixed_signs_f64(u64, v64, w64) {
             return no;
+        }
+        // `intersect::watertight::narrow_edges`: scaled up by EDGE_STEP until the largest is at
+        // least 1 / EDGE_STEP (powers of two: exact), so that none underflows when narrowed.
+        let step = f64(bitcast<f32>(EDGE_STEP_BITS));
+        let floor = 1.0 / step;
+        var largest = max(max(abs(u64), abs(v64)), abs(w64));
+        if largest < floor && largest != 0.0 {
+            bounded = false;
+            for (var i = 0u; i < 4u && largest < floor; i++) {
+                u64 = u64 * step;
+                v64 = v64 * step;
+                w64 = w64 * step;
+                largest = largest * step;
+            }
         }
         u = f32(u64);
         v = f32(v64);
@@ -231,7 +248,7 @@ fn tri_intersect(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>, tmin: f32, tmax: f
     }
     var hit = TriHit(true, t, div_rn(v, det), div_rn(w, det));
     // Decided before tmax is looked at, as on the CPU: tmax depends on the traversal order.
-    if tri_needs_refine(a, b, c, ax, ay, bx, by, cx, cy, az, bz, cz, t, det) {
+    if bounded && tri_needs_refine(a, b, c, ax, ay, bx, by, cx, cy, az, bz, cz, t, det) {
         let r = tri_refine(a0, b0, c0);
         if r.ok {
             hit = r;

@@ -8,7 +8,7 @@
 
 use crate::config::Dispatch;
 use crate::stream::shared_parts::{stream_header, INTERSECT_OWN, STREAM_COMMON};
-use raytrail_core::intersect::{FAR_PAD, REFINE_SCALE, RELIABLE_LIMIT, SLACK_SCALE};
+use raytrail_core::intersect::{EDGE_STEP, FAR_PAD, REFINE_SCALE, RELIABLE_LIMIT, SLACK_SCALE, TINY_EDGE};
 use raytrail_core::kd::traverse::{PACKET_WIDTH, SHORT_STACK_MAX};
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::WideWalk;
@@ -236,6 +236,8 @@ pub(crate) fn constants_header(method: Method) -> String {
          const SLACK_SCALE_BITS: u32 = {:#010x}u;\n\
          const RELIABLE_LIMIT_BITS: u32 = {:#010x}u;\n\
          const REFINE_SCALE_BITS: u32 = {:#010x}u;\n\
+         const TINY_EDGE_BITS: u32 = {:#010x}u;\n\
+         const EDGE_STEP_BITS: u32 = {:#010x}u;\n\
          // kd restart family: 0 restart, 1 push-down, 2 short stack.\n\
          const KD_MODE: u32 = {kd_mode}u;\n\
          const SHORT_STACK_MAX: u32 = {SHORT_STACK_MAX}u;\n\
@@ -250,6 +252,8 @@ pub(crate) fn constants_header(method: Method) -> String {
         SLACK_SCALE.to_bits(),
         RELIABLE_LIMIT.to_bits(),
         REFINE_SCALE.to_bits(),
+        TINY_EDGE.to_bits(),
+        EDGE_STEP.to_bits(),
         wide_packet = raytrail_core::wide::packet::WIDE_PACKET,
         hand_over = raytrail_core::wide::packet::HAND_OVER,
         wide_stream = raytrail_core::wide::STREAM_RAYS,

@@ -19,7 +19,7 @@ pub use moller_trumbore::MollerTrumbore;
 pub use refine::{REFINE_SCALE, REFINE_ULPS};
 pub use slab::{BoxHit, SlabRay, FAR_PAD};
 pub use slab_pair::{hit_pair_scalar, SlabPair};
-pub use watertight::{ShearedRay, Watertight};
+pub use watertight::{ShearedRay, Watertight, EDGE_STEP, TINY_EDGE};
 
 use crate::Ray;
 use glam::Vec3;

@@ -6,8 +6,8 @@ use glam::{BVec3A, Vec3, Vec3A, Vec3Swizzles};
 /// The watertight ray/triangle test of Woop, Benthin and Wald (2013), the default.
 ///
 /// The ray is sheared so it runs along +z; edge functions are evaluated in 2D and recomputed in
-/// `f64` when one is exactly zero, so that a ray through a shared edge or vertex hits exactly one
-/// of the triangles sharing it (no cracks, no double hits). Backfaces are not culled. Where a
+/// `f64` when one is zero or too small to trust ([`TINY_EDGE`]), so that a ray through a shared
+/// edge or vertex hits exactly one of the triangles sharing it (no cracks, no double hits). Backfaces are not culled. Where a
 /// first-order bound says the `f32` distance may be more than
 /// [`REFINE_ULPS`](super::REFINE_ULPS) ulps off (slanted slivers), `t` and the barycentrics are
 /// recomputed in `f64`.
@@ -109,12 +109,16 @@ impl TriangleTest for Watertight {
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            let [u64, v64, w64] = exact_edges([ax, ay], [bx, by], [cx, cy]);
-            if mixed_signs(u64, v64, w64) {
+        // Whether the first-order error bound applies (not to rescaled edge functions).
+        let mut bounded = true;
+        if is_tiny(u) || is_tiny(v) || is_tiny(w) {
+            let exact = exact_edges([ax, ay], [bx, by], [cx, cy]);
+            if mixed_signs(exact[0], exact[1], exact[2]) {
                 return None;
             }
-            (u, v, w) = (u64 as f32, v64 as f32, w64 as f32);
+            let rescaled;
+            ([u, v, w], rescaled) = narrow_edges(exact);
+            bounded = !rescaled;
         }
         if mixed_signs(u, v, w) {
             return None;
@@ -134,7 +138,7 @@ impl TriangleTest for Watertight {
         let mut hit = TriangleHit { t, u: v / det, v: w / det };
         // Decided before `tmax` is looked at: `tmax` is the closest hit so far, which depends on
         // the traversal order, and a refined `t` may cross it either way.
-        if needs_refine([a, b, c], [[ax, ay], [bx, by], [cx, cy]], [az, bz, cz], t, det) {
+        if bounded && needs_refine([a, b, c], [[ax, ay], [bx, by], [cx, cy]], [az, bz, cz], t, det) {
             if let Some((t, u, v)) = refine(r.origin, r.d, r.k, vertices) {
                 hit = TriangleHit { t, u, v };
             }
@@ -168,10 +172,49 @@ impl TriangleTest for Watertight {
     }
 }
 
-/// The edge functions `u, v, w` of the sheared vertices in `f64`, where the `f32` ones have a
-/// zero: each product of two `f32`s is exact in `f64`, so every sign is that of the exact edge
-/// function of these coordinates (the fallback of Woop, Benthin & Wald 2013 that keeps shared
-/// edges and vertices watertight).
+/// Edge functions below this magnitude are recomputed in `f64` ([`exact_edges`]), as exact zeros
+/// are in Woop, Benthin & Wald 2013. Below it an `f32` product may have underflowed (gradually on
+/// the CPU, flushed to zero on many GPUs) by more than a rounding error of the edge function, and
+/// its sign can be wrong: in a unit-size scene with vertices near `1e-37` (a fuzzed scene of
+/// coordinates `1e-1` to `1e36`, scaled) a ray passing outside a triangle hit it. At `2^-100` a
+/// flushed product's error, at most `2^-126`, stays below half an ulp of the function.
+pub const TINY_EDGE: f32 = f32::from_bits((127 - 100) << 23); // 2^-100
+
+/// The step by which [`narrow_edges`] scales tiny `f64` edge functions up (and `1 / EDGE_STEP`
+/// the magnitude it scales them to at least).
+pub const EDGE_STEP: f32 = 18_446_744_073_709_551_616.0; // 2^64
+
+/// Whether an `f32` edge function is too small for its sign to be trusted ([`TINY_EDGE`]).
+#[inline(always)]
+fn is_tiny(x: f32) -> bool {
+    x.abs() < TINY_EDGE
+}
+
+/// The `f64` edge functions as `f32`s, first scaled by a power of two that brings the largest to
+/// at least `1 / EDGE_STEP` where it is smaller, and whether they were scaled. `t` and the
+/// barycentrics are ratios of the three, so a common factor cancels; narrowed as they are, edge
+/// functions below the `f32` range turned into zeros and a ray through a triangle of tiny
+/// features missed it with `det = 0`. A nonzero one is at least `2^-298` (a difference of products
+/// of `f32`s), so four steps suffice.
+#[inline(never)]
+fn narrow_edges(e: [f64; 3]) -> ([f32; 3], bool) {
+    let (step, floor) = (f64::from(EDGE_STEP), 1.0 / f64::from(EDGE_STEP));
+    let largest = e[0].abs().max(e[1].abs()).max(e[2].abs());
+    if largest >= floor || largest == 0.0 {
+        return (e.map(|x| x as f32), false);
+    }
+    let (mut e, mut largest) = (e, largest);
+    while largest < floor {
+        e = e.map(|x| x * step);
+        largest *= step;
+    }
+    (e.map(|x| x as f32), true)
+}
+
+/// The edge functions `u, v, w` of the sheared vertices in `f64`, where an `f32` one is tiny
+/// ([`TINY_EDGE`]): each product of two `f32`s is exact in `f64`, so every sign is that of the
+/// exact edge function of these coordinates (the fallback of Woop, Benthin & Wald 2013 that keeps
+/// shared edges and vertices watertight).
 #[inline(always)]
 fn exact_edges(a: [f32; 2], b: [f32; 2], c: [f32; 2]) -> [f64; 3] {
     let f = |p: [f32; 2], q: [f32; 2]| f64::from(p[0]) * f64::from(q[1]) - f64::from(p[1]) * f64::from(q[0]);
@@ -193,7 +236,7 @@ fn mixed_signs<F: PartialOrd + From<f32>>(u: F, v: F, w: F) -> bool {
 #[cfg(target_arch = "x86_64")]
 mod sse {
     use super::super::REFINE_SCALE;
-    use super::{BlockHits, ShearedRay, TriangleBlock, TriangleTest, Watertight};
+    use super::{BlockHits, ShearedRay, TriangleBlock, TriangleTest, Watertight, TINY_EDGE};
     use core::arch::x86_64::{
         __m128, _mm_add_ps, _mm_and_ps, _mm_andnot_ps, _mm_cmpeq_ps, _mm_cmpgt_ps, _mm_cmplt_ps, _mm_cmpngt_ps,
         _mm_cmpnlt_ps, _mm_div_ps, _mm_loadu_ps, _mm_movemask_ps, _mm_mul_ps, _mm_or_ps, _mm_set1_ps, _mm_storeu_ps,
@@ -230,7 +273,8 @@ mod sse {
             let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
             let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
             let z = splat(0.0);
-            let zero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, z), _mm_cmpeq_ps(v, z)), _mm_cmpeq_ps(w, z));
+            let tiny = |x: __m128| _mm_cmplt_ps(_mm_andnot_ps(splat(-0.0), x), splat(TINY_EDGE));
+            let zero = _mm_or_ps(_mm_or_ps(tiny(u), tiny(v)), tiny(w));
             let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, z), _mm_cmplt_ps(v, z)), _mm_cmplt_ps(w, z));
             let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, z), _mm_cmpgt_ps(v, z)), _mm_cmpgt_ps(w, z));
             let det = _mm_add_ps(_mm_add_ps(u, v), w);
@@ -248,6 +292,7 @@ mod sse {
                 _mm_and_ps(finite, _mm_cmpnlt_ps(t, splat(tmin))),
             );
             let ok = _mm_and_ps(ahead, _mm_cmpngt_ps(t, splat(tmax)));
+            // Lanes with a tiny edge function take the scalar test.
             let zero = _mm_movemask_ps(zero) as u32;
             // The bound only where a lane hits (rare among blocks), so a block of misses pays
             // one branch for it.
@@ -334,6 +379,28 @@ mod tests {
         }
     }
 
+    /// A fuzzed scene of coordinates from `0.37` to `2e36`, scaled to unit size: vertices near
+    /// `1e-37` and `1e-25` around a ray along `y`, where every `f32` edge function's products
+    /// underflow. The zero one went to the `f64` fallback, but the narrowed results were
+    /// subnormal, and the triangle was hit at `t = 0` where its exact crossing lies at
+    /// `t = 18697088683.79` (computed in rationals), far past `tmax`.
+    #[test]
+    fn edge_functions_below_the_f32_range_keep_their_ratios() {
+        let v = |b: [u32; 3]| Vec3::from_array(b.map(f32::from_bits));
+        let d = v([0x04c1_4100, 0x24c1_4140, 0x04c1_4141]);
+        let [a, b, c] = [
+            v([0x823e_bebe, 0x3efb_7b7b, 0x15fb_7b7b]),
+            v([0x15d2_5252; 3]),
+            v([0x15d2_5252, 0x15d2_5252, 0x1dd2_5252]),
+        ];
+        let tmax = 12.078_431;
+        let r = Watertight::prepare(&Ray::new(Vec3::ZERO, d, 0.0, tmax));
+        assert_eq!(Watertight::intersect(&r, a, b, c, 0.0, tmax), None);
+        let hit = Watertight::intersect(&r, a, b, c, 0.0, f32::INFINITY).expect("the line crosses the triangle");
+        let exact = 18_697_088_683.79f64;
+        assert!((f64::from(hit.t) - exact).abs() < 1e-6 * exact, "t = {} against {exact}", hit.t);
+    }
+
     #[test]
     fn hits_center_with_barycentrics() {
         let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
@@ -389,12 +456,15 @@ mod tests {
         let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
         let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
         let (mut u, mut v, mut w) = (cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax);
-        if u == 0.0 || v == 0.0 || w == 0.0 {
+        let mut bounded = true;
+        if u.abs() < TINY_EDGE || v.abs() < TINY_EDGE || w.abs() < TINY_EDGE {
             let [u64, v64, w64] = exact_edges([ax, ay], [bx, by], [cx, cy]);
             if mixed_signs(u64, v64, w64) {
                 return None;
             }
-            (u, v, w) = (u64 as f32, v64 as f32, w64 as f32);
+            let rescaled;
+            ([u, v, w], rescaled) = narrow_edges([u64, v64, w64]);
+            bounded = !rescaled;
         }
         if mixed_signs(u, v, w) {
             return None;
@@ -411,7 +481,7 @@ mod tests {
         let k = [kx, ky, kz];
         let rel = [a, b, c].map(|p| k.map(|i| p[i]));
         let xy = [[ax, ay], [bx, by], [cx, cy]];
-        if needs_refine(rel, xy, [sz * a[kz], sz * b[kz], sz * c[kz]], t, det) {
+        if bounded && needs_refine(rel, xy, [sz * a[kz], sz * b[kz], sz * c[kz]], t, det) {
             let o = ray.origin();
             let [p, q, r] = &vertices;
             if let Some((t, u, v)) = refine(k.map(|i| o[i]), k.map(|i| d[i]), k, [p, q, r]) {

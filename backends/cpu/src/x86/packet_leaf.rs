@@ -20,7 +20,7 @@
 //! a function not compiled for AVX, and the compiler then leaves them as calls (0.18-0.84x when
 //! tried: `docs/notes/*-benchmarks-packet-leaves.md`, "Packet leaves with the rays in the lanes").
 
-use raytrail_core::intersect::{TriangleHit, TriangleTest, REFINE_SCALE};
+use raytrail_core::intersect::{TriangleHit, TriangleTest, REFINE_SCALE, TINY_EDGE};
 use raytrail_core::observe::Observer;
 use raytrail_core::wide::packet::PacketLanes;
 use raytrail_core::wide::WideMemory;
@@ -28,8 +28,8 @@ use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps, _mm256_blendv_ps,
     _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_div_ps, _mm256_loadu_ps, _mm256_loadu_si256,
     _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_permutevar8x32_ps, _mm256_set1_epi32, _mm256_set1_ps,
-    _mm256_setzero_ps, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_ps, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ,
-    _CMP_LT_OQ, _CMP_NEQ_UQ, _CMP_NGT_UQ, _CMP_NLT_UQ,
+    _mm256_setzero_ps, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_ps, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LT_OQ,
+    _CMP_NEQ_UQ, _CMP_NGT_UQ, _CMP_NLT_UQ,
 };
 
 /// Eight rays' watertight constants by lane.
@@ -233,10 +233,12 @@ unsafe fn triangle(r: &RayLanes, v: *const f32) -> TriangleLanes {
     let v = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
     let w = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
     let z = _mm256_setzero_ps();
-    let eq = |x: __m256| _mm256_cmp_ps::<_CMP_EQ_OQ>(x, z);
+    let abs = |x: __m256| _mm256_andnot_ps(splat(-0.0), x);
+    // An edge function below `TINY_EDGE` sends the lane to the scalar test's `f64` fallback.
+    let tiny = |x: __m256| _mm256_cmp_ps::<_CMP_LT_OQ>(abs(x), splat(TINY_EDGE));
     let lt = |x: __m256| _mm256_cmp_ps::<_CMP_LT_OQ>(x, z);
     let gt = |x: __m256| _mm256_cmp_ps::<_CMP_GT_OQ>(x, z);
-    let zero = _mm256_or_ps(_mm256_or_ps(eq(u), eq(v)), eq(w));
+    let zero = _mm256_or_ps(_mm256_or_ps(tiny(u), tiny(v)), tiny(w));
     let neg = _mm256_or_ps(_mm256_or_ps(lt(u), lt(v)), lt(w));
     let pos = _mm256_or_ps(_mm256_or_ps(gt(u), gt(v)), gt(w));
     let det = _mm256_add_ps(_mm256_add_ps(u, v), w);
@@ -247,7 +249,6 @@ unsafe fn triangle(r: &RayLanes, v: *const f32) -> TriangleLanes {
         _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, az), _mm256_mul_ps(v, bz)), _mm256_mul_ps(w, cz)),
         det,
     );
-    let abs = |x: __m256| _mm256_andnot_ps(splat(-0.0), x);
     // `!t.is_finite() || t < tmin || t > tmax` rejects: NaN fails `|t| < inf`.
     let finite = _mm256_cmp_ps::<_CMP_LT_OQ>(abs(t), splat(f32::INFINITY));
     let det_ok = _mm256_cmp_ps::<_CMP_NEQ_UQ>(det, z);
