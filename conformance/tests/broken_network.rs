@@ -65,7 +65,10 @@ impl<const D: usize> Trace for Faulty<D> {
         let m = WideMethod::try_from(opts.method)?;
         let (root, tree) = (scene.wide_root(m)?, scene.wide_tree(m)?);
         let mut enumerations = Vec::new();
-        for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+        // In the scene's frame, as every backend traces (directions of adversarial sizes are
+        // scaled to unit size).
+        let framed = scene.frame_rays(rays);
+        for (ray, hit) in framed.rays().iter().zip(hits.iter_mut()) {
             let mut o = Both(Counters::default(), Recorder::default());
             *hit = match tree {
                 WideTree::Four(t) => trace_wide_ray::<4, _, Watertight, DroppedExchange<D>, _>(
@@ -85,6 +88,7 @@ impl<const D: usize> Trace for Faulty<D> {
             };
             enumerations.push(scene.canonical_ids(opts.method, o.1.nodes)?);
         }
+        framed.finish(hits);
         let mut report = Report::new(rays.len(), 0.0);
         report.enumerations = (opts.record == Record::Enumerations).then_some(enumerations);
         Ok(report)
