@@ -264,6 +264,11 @@ pub struct TraceArgs {
     /// Also write where in the mesh file each primitive id comes from (CSV: prim,file,<where>)
     #[arg(long, value_name = "FILE.csv")]
     pub prim_map: Option<PathBuf>,
+    /// For a scene file of instances: a NumPy file of one unsigned mask per ray (shape (N,));
+    /// a ray enters only the instances whose mask shares a bit with its own (all bits where
+    /// left out)
+    #[arg(long, value_name = "MASKS.npy")]
+    pub masks: Option<PathBuf>,
     /// Most rays the ray file may hold
     #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
     pub max_rays: u64,

@@ -120,6 +120,15 @@ pub enum NpyErrorKind {
         /// The shape found.
         shape: Vec<u64>,
     },
+    /// An element's value is outside what it stands for (a 64-bit mask above 32 bits).
+    OutOfRange {
+        /// The element's index.
+        index: u64,
+        /// Its value.
+        value: u64,
+        /// What it must fit in.
+        limit: &'static str,
+    },
     /// The file ends early.
     Truncated {
         /// Which part is cut short: `"preamble"` (magic, version, header length), `"header"`
@@ -202,6 +211,9 @@ impl fmt::Display for NpyErrorKind {
             NpyErrorKind::TooLarge { shape } => {
                 write!(f, "an array of shape {} is too large for this machine", ShapeDisplay(shape))
             }
+            NpyErrorKind::OutOfRange { index, value, limit } => {
+                write!(f, "element {index} is {value}, which does not fit in {limit}")
+            }
             NpyErrorKind::Truncated { part, expected, found } => {
                 write!(f, "truncated {part}: expected {expected} bytes, found {found}")
             }
@@ -255,6 +267,44 @@ pub fn read_points(path: impl AsRef<Path>) -> Result<Vec<[f32; 3]>, NpyError> {
     let path = path.as_ref();
     let file = File::open(path).map_err(|e| NpyError::new(path, NpyErrorKind::Io(e)))?;
     read_float_rows::<3>(&mut BufReader::new(file), "(N, 3)").map_err(|k| NpyError::new(path, k))
+}
+
+/// Reads ray masks from the `.npy` file at `path` (`trace --masks`): an unsigned integer array of
+/// shape `(N,)` (`<u4`, `>u4`, or `u1`, `u2`, `u8` whose values fit in 32 bits), one mask per ray.
+pub fn read_masks(path: impl AsRef<Path>) -> Result<Vec<u32>, NpyError> {
+    let path = path.as_ref();
+    let file = File::open(path).map_err(|e| NpyError::new(path, NpyErrorKind::Io(e)))?;
+    read_masks_impl(&mut BufReader::new(file)).map_err(|k| NpyError::new(path, k))
+}
+
+fn read_masks_impl(r: &mut impl Read) -> Result<Vec<u32>, NpyErrorKind> {
+    const EXPECTED_DTYPE: &str = "an unsigned integer ('u1', '<u2', '<u4' or '<u8', either byte order)";
+    let header = read_header(r)?;
+    let wrong = || NpyErrorKind::WrongDtype { found: header.descr.to_string(), expected: EXPECTED_DTYPE };
+    let Value::Str(descr) = &header.descr else {
+        return Err(wrong());
+    };
+    let scalar = parse_scalar(descr).filter(|s| s.kind == b'u' && [1, 2, 4, 8].contains(&s.size)).ok_or_else(wrong)?;
+    let n = match header.shape[..] {
+        [n] => n,
+        _ => return Err(NpyErrorKind::WrongShape { found: header.shape, expected: "(N,)" }),
+    };
+    check_order(&header)?;
+    let total = byte_size(&header.shape, scalar.size)?;
+    let values = read_records(r, n, scalar.size, total, |b| match scalar.size {
+        1 => u64::from(b[0]),
+        2 if scalar.big_endian => u64::from(u16::from_be_bytes([b[0], b[1]])),
+        2 => u64::from(u16::from_le_bytes([b[0], b[1]])),
+        4 => u64::from(u32_at(b, 0, scalar.big_endian)),
+        _ => u64_at(b, 0, scalar.big_endian),
+    })?;
+    values
+        .into_iter()
+        .enumerate()
+        .map(|(i, m)| {
+            u32::try_from(m).map_err(|_| NpyErrorKind::OutOfRange { index: i as u64, value: m, limit: "32 bits" })
+        })
+        .collect()
 }
 
 /// The `descr` of a nearest-point file (`raytrail nearest`).

@@ -33,9 +33,19 @@ pub fn main(a: TraceArgs) -> Outcome {
     }
     check_input("rays", &a.rays)?;
     check_input("scene", &a.scene)?;
+    let mut inputs = vec![("rays", a.rays.as_path()), ("scene", a.scene.as_path())];
+    if let Some(masks) = &a.masks {
+        if !crate::instances::is_instance_file(&a.scene) {
+            return Err(Failure::Usage(
+                "--masks needs a scene file of instances (.json): a mesh's triangles carry no masks".into(),
+            ));
+        }
+        check_input("masks", masks)?;
+        inputs.push(("masks", masks.as_path()));
+    }
     let mut outputs = vec![("out", a.out.as_path())];
     outputs.extend(a.prim_map.as_deref().map(|m| ("prim-map", m)));
-    check_distinct(&[("rays", a.rays.as_path()), ("scene", a.scene.as_path())], &outputs)?;
+    check_distinct(&inputs, &outputs)?;
     let rays = npy::read_rays(&a.rays).map_err(|e| e.to_string())?;
     check_count("rays", rays.len() as u64, "max-rays", a.max_rays, RAY_AND_HIT_BYTES)?;
     if crate::instances::is_instance_file(&a.scene) {
@@ -95,6 +105,23 @@ fn instanced(a: &TraceArgs, rays: &[Ray], outputs: &[(&str, &std::path::Path)]) 
         let flag = if a.all { "--all" } else { "--prim-map" };
         return Err(Failure::Usage(format!("{flag} is not available for a scene file of instances")));
     }
+    let masks = match &a.masks {
+        Some(path) => {
+            let masks = npy::read_masks(path).map_err(|e| e.to_string())?;
+            if masks.len() != rays.len() {
+                return Err(format!(
+                    "--masks {} holds {} masks for the {} rays of --rays {}: one mask per ray",
+                    path.display(),
+                    masks.len(),
+                    rays.len(),
+                    a.rays.display()
+                )
+                .into());
+            }
+            Some(masks)
+        }
+        None => None,
+    };
     let file = crate::instances::load_instances(&a.scene, &a.load.load_options())?;
     let inputs: Vec<(&str, &std::path::Path)> = file.mesh_paths.iter().map(|p| ("scene", p.as_path())).collect();
     check_distinct(&inputs, outputs)?;
@@ -118,7 +145,8 @@ fn instanced(a: &TraceArgs, rays: &[Ray], outputs: &[(&str, &std::path::Path)]) 
     });
     let mut hits = try_vec(rays.len(), InstanceHit::MISS, "hits")?;
     let start = std::time::Instant::now();
-    let report = trace_instanced(&backend, &scene, rays, None, &opts, &mut hits).map_err(|e| e.to_string())?;
+    let report =
+        trace_instanced(&backend, &scene, rays, masks.as_deref(), &opts, &mut hits).map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     npy::write_instance_hits(&a.out, &hits).map_err(|e| e.to_string())?;
     let n_hit = hits.iter().filter(|h| h.is_hit()).count();

@@ -1,6 +1,6 @@
 //! `trace` on a scene file of instances (a JSON file of mesh paths and placements): each hit
-//! names its instance's id, an instance placed by the identity answers as the mesh itself, and a
-//! file that is wrong says where.
+//! names its instance's id, an instance placed by the identity answers as the mesh itself, ray
+//! masks (`--masks`) pick the instances a ray enters, and a file that is wrong says where.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -139,4 +139,77 @@ fn an_output_naming_a_mesh_of_the_scene_file_is_refused_and_the_mesh_kept() {
     let out = run(&[&"trace", &"--scene", &scene, &"--rays", &rays, &"--out", &hits, &"--all"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("--all is not available"), "{}", stderr(&out));
+}
+
+/// A `.npy` file of `u4` masks, one per ray, written by hand (the layout `numpy.save` writes).
+fn write_masks(path: &Path, masks: &[u32]) {
+    let mut header = format!("{{'descr': '<u4', 'fortran_order': False, 'shape': ({},), }}", masks.len());
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((header.len() as u16).to_le_bytes());
+    bytes.extend(header.as_bytes());
+    bytes.extend(masks.iter().flat_map(|m| m.to_le_bytes()));
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn ray_masks_pick_the_instances_a_ray_may_enter() {
+    let dir = folder("masks");
+    let rays = camera_rays(&dir);
+    let n = records(&rays, "'<f4'", 32).len();
+    // Two copies of the built-in scene in one place: mask 1 (id 3) and mask 2 (id 4).
+    let scene = dir.join("scene.json");
+    std::fs::write(
+        &scene,
+        r#"{"meshes": ["builtin"], "instances": [{"mesh": 0, "id": 3, "mask": 1}, {"mesh": 0, "id": 4, "mask": 2}]}"#,
+    )
+    .unwrap();
+    let (masks, hits) = (dir.join("masks.npy"), dir.join("hits.npy"));
+    // Even rays see only the second copy, odd rays only the first.
+    write_masks(&masks, &(0..n).map(|i| if i % 2 == 0 { 2 } else { 1 }).collect::<Vec<_>>());
+    let out = run(&[&"trace", &"--scene", &scene, &"--rays", &rays, &"--out", &hits, &"--masks", &masks]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let got = records(&hits, "('instance', '<u4')", 20);
+    let mut seen = [0; 2];
+    for (i, r) in got.iter().enumerate() {
+        if word(r, 1) != u32::MAX {
+            let want = if i % 2 == 0 { 4 } else { 3 };
+            assert_eq!(word(r, 4), want, "ray {i} hit instance {} through its mask", word(r, 4));
+            seen[i % 2] += 1;
+        }
+    }
+    assert!(seen.iter().all(|&k| k >= 25), "hits per mask {seen:?}: the test would show little");
+    // A mask of no shared bit enters nothing.
+    write_masks(&masks, &vec![4; n]);
+    let out = run(&[&"trace", &"--scene", &scene, &"--rays", &rays, &"--out", &hits, &"--masks", &masks]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(records(&hits, "('instance', '<u4')", 20).iter().all(|r| word(r, 1) == u32::MAX));
+}
+
+#[test]
+fn wrong_masks_say_what_is_wrong() {
+    let dir = folder("wrong-masks");
+    let rays = camera_rays(&dir);
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, r#"{"meshes": ["builtin"], "instances": [{"mesh": 0}]}"#).unwrap();
+    let (masks, hits) = (dir.join("masks.npy"), dir.join("hits.npy"));
+    write_masks(&masks, &[1, 2, 3]);
+    let out = run(&[&"trace", &"--scene", &scene, &"--rays", &rays, &"--out", &hits, &"--masks", &masks]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("holds 3 masks") && err.contains("one mask per ray"), "{err}");
+    // On a mesh, masks have nothing to pick.
+    let out = run(&[&"trace", &"--scene", &"builtin", &"--rays", &rays, &"--out", &hits, &"--masks", &masks]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--masks needs a scene file of instances"), "{err}");
+    // A float array is not a mask file.
+    let out = run(&[&"trace", &"--scene", &scene, &"--rays", &rays, &"--out", &hits, &"--masks", &rays]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("unsigned integer"), "{err}");
+    assert!(!hits.exists(), "a hits file was written");
 }
