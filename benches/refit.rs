@@ -4,18 +4,19 @@
 //! default tracer's scene ([`AUTO_WALKS`]: the canonical BVH2 and its 8-wide tree of least node
 //! area) and a scene prepared for every method:
 //! - `rebuild`: [`Builder::Best`] on the moved triangles, then [`PreparedScene::new`];
-//! - `refit`: [`PreparedScene::refit`] of the scene built for the first frame.
+//! - `refit`: [`CpuBackend::refit`] of the scene built for the first frame, on rayon's pool.
 //!
 //! The frames are the scene's vertices moved by the conformance suite's [`breathing`] (every
 //! vertex pushed from or pulled to the centre by a factor that varies along x), one phase per
 //! iteration in turn. Scenes: the sphereflake (generated, always there) and the dragon and Sponza
 //! from `../shared/scenes` (or `RAYTRAIL_SCENES`), left out when absent. The builders run on
-//! rayon's pool as the tracer's do (`RAYON_NUM_THREADS` fixes its size); the refit is serial.
+//! rayon's pool as the tracer's do (`RAYON_NUM_THREADS` fixes its size), and so does the refit.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
 use raytrail::core::method::Method;
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::scene::Scene;
+use raytrail::cpu::CpuBackend;
 use raytrail::{Builder, AUTO_WALKS};
 use raytrail_conformance::paths::{find_mesh, load_mesh_scene};
 use raytrail_conformance::scenes::{breathing, sphereflake};
@@ -53,11 +54,12 @@ fn refit_against_rebuild(c: &mut Criterion) {
             });
             let bvh = Builder::Best.build(&scene).expect("build");
             let mut prepared = PreparedScene::new(&scene, bvh, methods).expect("prepare");
+            let backend = CpuBackend::new();
             group.bench_function(BenchmarkId::new("refit", parts), |b| {
                 let mut k = 0;
                 b.iter(|| {
                     k = (k + 1) % frames.len();
-                    prepared.refit(&frames[k]).expect("refit");
+                    backend.refit(&mut prepared, &frames[k]).expect("refit");
                 })
             });
         }

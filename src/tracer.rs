@@ -317,7 +317,7 @@ impl Tracer {
     /// [`Tracer::refit`] to a scene of the same number of triangles.
     pub fn refit_scene(&mut self, scene: &Scene) -> Result<(), Error> {
         // A prepared scene the caller still holds ([`Tracer::prepared`]) is copied, not changed.
-        Arc::make_mut(&mut self.scene.0).refit(scene)?;
+        self.backend.refit(Arc::make_mut(&mut self.scene.0), scene)?;
         Ok(())
     }
 

@@ -3,8 +3,8 @@
 //! `cargo bench -p raytrail-cli --features embree --bench embree_queries` times, side by side in
 //! one process:
 //! - `refit/<scene>`: a new frame of the conformance suite's [`breathing`] move (one phase per
-//!   iteration in turn) taken by `raytrail` ([`PreparedScene::refit`] of the default tracer's
-//!   parts, [`AUTO_WALKS`]), by `embree-refit` (the vertices written into Embree's buffer, the
+//!   iteration in turn) taken by `raytrail` ([`CpuBackend::refit`] of the default tracer's parts,
+//!   [`AUTO_WALKS`], on rayon's pool), by `embree-refit` (the vertices written into Embree's buffer, the
 //!   geometry at `RTC_BUILD_QUALITY_REFIT` in a dynamic scene at low quality, `rtcCommitScene`)
 //!   and by `embree-rebuild` (the same at Embree's default quality, which builds the tree again). Scenes: the sphereflake, the
 //!   dragon and Sponza, as the `refit` bench of the `raytrail` crate.
@@ -27,6 +27,7 @@ use rayon::prelude::*;
 use raytrail::core::nearest::closest_point_on_triangle;
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::scene::Scene;
+use raytrail::cpu::CpuBackend;
 use raytrail::{Builder, TracerBuilder, AUTO_WALKS};
 use raytrail_conformance::paths::{find_mesh, load_mesh_scene};
 use raytrail_conformance::rays::query_points;
@@ -118,11 +119,12 @@ fn refit(c: &mut Criterion) {
         group.sampling_mode(SamplingMode::Flat).sample_size(10).measurement_time(Duration::from_secs(8));
         let bvh = Builder::Best.build(&scene).expect("build");
         let mut prepared = PreparedScene::new(&scene, bvh, &AUTO_WALKS).expect("prepare");
+        let backend = CpuBackend::new();
         group.bench_function(BenchmarkId::from_parameter("raytrail"), |b| {
             let mut k = 0;
             b.iter(|| {
                 k = (k + 1) % frames.len();
-                prepared.refit(&frames[k]).expect("refit");
+                backend.refit(&mut prepared, &frames[k]).expect("refit");
             })
         });
         for (peer, quality) in [("embree-refit", BuildQuality::REFIT), ("embree-rebuild", BuildQuality::MEDIUM)] {

@@ -13,6 +13,7 @@ mod chunk;
 mod kd;
 mod nearest;
 mod record;
+mod refit;
 mod stream;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod test_rng;

@@ -10,8 +10,8 @@ use raytrail_core::trace::TraceOptions;
 use raytrail_core::wide::FastKernel;
 use raytrail_core::{Error, Hit, Ray};
 
-/// Stage items on rayon's current pool.
-struct Rayon;
+/// Stage items (and a refit's passes, [`crate::refit`]) on rayon's current pool.
+pub(crate) struct Rayon;
 
 /// From this many items on, a task takes at least [`MIN_PER_TASK`] of them: such stages map cheap
 /// items (a ray's key), and one per task would cost more in scheduling than in work. Fewer items
@@ -26,6 +26,10 @@ impl Parallel for Rayon {
     fn map<T: Send>(&self, n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
         let min = if n >= MANY_ITEMS { MIN_PER_TASK } else { 1 };
         (0..n).into_par_iter().with_min_len(min).map(f).collect()
+    }
+
+    fn for_each_chunk<T: Send>(&self, data: &mut [T], chunk: usize, f: impl Fn(usize, &mut [T]) + Sync + Send) {
+        data.par_chunks_mut(chunk.max(1)).enumerate().for_each(|(i, piece)| f(i, piece));
     }
 
     /// A parallel sort of (key, chunk index) pairs packed in a `u64`: the chunks come in base

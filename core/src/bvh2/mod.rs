@@ -23,7 +23,7 @@ mod cost;
 #[cfg(feature = "alloc")]
 mod layout;
 #[cfg(feature = "alloc")]
-mod refit;
+pub(crate) mod refit;
 #[cfg(feature = "alloc")]
 mod sah;
 #[cfg(feature = "alloc")]

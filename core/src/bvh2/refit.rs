@@ -9,7 +9,11 @@
 
 use super::tree::{Bvh2, NodeKind};
 use crate::geometry::Triangle;
+use crate::stream::{Parallel, Serial};
 use crate::{Aabb, Error};
+
+/// Nodes a task of a parallel refit takes at once.
+pub(crate) const REFIT_CHUNK: usize = 4096;
 
 impl Bvh2 {
     /// Makes every box again from `triangles` (by primitive id, as many as the tree holds): a leaf's
@@ -18,6 +22,12 @@ impl Bvh2 {
     ///
     /// [`Error::TreeMismatch`] when the triangle count is not the tree's.
     pub fn refit(&mut self, triangles: &[Triangle]) -> Result<(), Error> {
+        self.refit_with(triangles, &Serial)
+    }
+
+    /// [`Bvh2::refit`] with the leaves' boxes (the reads of the triangles, most of the time) made
+    /// on `par`; the inner nodes follow in one backward sweep. The boxes are the same either way.
+    pub fn refit_with(&mut self, triangles: &[Triangle], par: &impl Parallel) -> Result<(), Error> {
         if triangles.len() != self.prim_count() {
             return Err(Error::TreeMismatch {
                 node: 0,
@@ -25,15 +35,24 @@ impl Bvh2 {
             });
         }
         let (nodes, prim_order) = self.nodes_and_order_mut();
+        let leaf_box = |first: u32, count: u32| {
+            prim_order[first as usize..(first + count) as usize]
+                .iter()
+                .fold(Aabb::EMPTY, |b, &p| b.union(triangles[p as usize].bounds()))
+        };
+        par.for_each_chunk(nodes, REFIT_CHUNK, |_, piece| {
+            for node in piece {
+                if let NodeKind::Leaf { first, count } = node.kind {
+                    node.bounds = leaf_box(first, count);
+                }
+            }
+        });
         // Pre-order: every child has a larger index than its parent, so a backward sweep meets
         // children before parents.
         for i in (0..nodes.len()).rev() {
-            nodes[i].bounds = match nodes[i].kind {
-                NodeKind::Leaf { first, count } => prim_order[first as usize..(first + count) as usize]
-                    .iter()
-                    .fold(Aabb::EMPTY, |b, &p| b.union(triangles[p as usize].bounds())),
-                NodeKind::Internal { left, right } => nodes[left as usize].bounds.union(nodes[right as usize].bounds),
-            };
+            if let NodeKind::Internal { left, right } = nodes[i].kind {
+                nodes[i].bounds = nodes[left as usize].bounds.union(nodes[right as usize].bounds);
+            }
         }
         Ok(())
     }

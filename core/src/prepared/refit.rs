@@ -6,7 +6,7 @@ use crate::bvh2::{BinaryLayout, LinkKind};
 use crate::kd::KdBuilder;
 use crate::method::WideMethod;
 use crate::scene::Scene;
-use crate::stream::LevelBvh;
+use crate::stream::{LevelBvh, Parallel, Serial};
 use crate::wide::WideBvh;
 use crate::Error;
 
@@ -34,6 +34,13 @@ impl PreparedScene {
     /// [`Error::TreeMismatch`] when `moved` has another triangle count; the scene is then
     /// unchanged. [`PreparedScene::timings`] afterwards holds the refit's times.
     pub fn refit(&mut self, moved: &Scene) -> Result<(), Error> {
+        self.refit_with(moved, &Serial)
+    }
+
+    /// [`PreparedScene::refit`] with its passes over leaves, nodes and triangles on `par` (the CPU
+    /// backend's pool: [`Bvh2::refit_with`](crate::bvh2::Bvh2::refit_with)); the result is the
+    /// same bit for bit.
+    pub fn refit_with(&mut self, moved: &Scene, par: &impl Parallel) -> Result<(), Error> {
         if moved.triangles().len() != self.bvh.prim_count() {
             return Err(Error::TreeMismatch {
                 node: 0,
@@ -47,7 +54,7 @@ impl PreparedScene {
         // error leaves the scene as it was.
         let t0 = seconds_since(None);
         let mut bvh = self.bvh.clone();
-        bvh.refit(tris)?;
+        bvh.refit_with(tris, par)?;
         let layout = |old: &Option<BinaryLayout>, links| old.as_ref().map(|_| BinaryLayout::new(&bvh, tris, links));
         let uncles = layout(&self.uncles, LinkKind::Uncles).transpose()?;
         let parents = layout(&self.parents, LinkKind::ParentSibling).transpose()?;
@@ -62,38 +69,60 @@ impl PreparedScene {
             None => None,
         };
         timings.kd = seconds_since(Some(t1));
+        // The wide trees are refitted in place once nothing can fail any more (their checks
+        // first), not as copies: a copy of the dragon's 8-wide tree (its nodes, triangles and
+        // blocks) was about a quarter of the refit's time. The stream methods' level tree, made
+        // from the refitted 8-wide tree, can fail, so where it is kept that tree is refitted as a
+        // copy first.
         let t2 = seconds_since(None);
-        fn refit<const W: usize>(
-            tree: &Option<WideBvh<W>>,
-            bvh: &crate::bvh2::Bvh2,
-            tris: &[crate::geometry::Triangle],
-        ) -> Result<Option<WideBvh<W>>, Error> {
-            let mut tree = tree.clone();
-            if let Some(t) = &mut tree {
-                t.refit(bvh, tris)?;
-            }
-            Ok(tree)
+        for check in [
+            self.wide4.as_ref().map(|t| t.check_refit(&bvh, tris)),
+            self.wide8.as_ref().map(|t| t.check_refit(&bvh, tris)),
+            self.wide4_naive.as_ref().map(|t| t.check_refit(&bvh, tris)),
+            self.wide8_sah.as_ref().map(|t| t.check_refit(&bvh, tris)),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            check?;
         }
-        let wide4 = refit(&self.wide4, &bvh, tris)?;
-        let wide8 = refit(&self.wide8, &bvh, tris)?;
-        let wide4_naive = refit(&self.wide4_naive, &bvh, tris)?;
-        let wide8_sah = refit(&self.wide8_sah, &bvh, tris)?;
-        timings.wide = seconds_since(Some(t2));
         let t3 = seconds_since(None);
-        let levels = match &self.levels {
+        let (levels, wide8) = match &self.levels {
             Some(_) => {
                 let bounds = bvh.nodes()[0].bounds;
-                Some(match &wide8 {
-                    Some(w) => LevelBvh::new(w, &bounds)?,
-                    None => LevelBvh::new(&WideBvh::build(&bvh, tris, WideMethod::BVH8.collapse())?, &bounds)?,
-                })
+                match &self.wide8 {
+                    Some(w) => {
+                        let mut w = w.clone();
+                        w.refit_checked(&bvh, tris, par);
+                        (Some(LevelBvh::new(&w, &bounds)?), Some(w))
+                    }
+                    None => {
+                        let w = WideBvh::build(&bvh, tris, WideMethod::BVH8.collapse())?;
+                        (Some(LevelBvh::new(&w, &bounds)?), None)
+                    }
+                }
             }
-            None => None,
+            None => (None, None),
         };
         timings.levels = seconds_since(Some(t3));
-        (self.bvh, self.uncles, self.parents, self.kd) = (bvh, uncles, parents, kd);
-        (self.wide4, self.wide8, self.wide4_naive, self.wide8_sah, self.levels) =
-            (wide4, wide8, wide4_naive, wide8_sah, levels);
+        // Nothing fails from here on.
+        let t4 = seconds_since(None);
+        for tree in [&mut self.wide4, &mut self.wide4_naive].into_iter().flatten() {
+            tree.refit_checked(&bvh, tris, par);
+        }
+        if let Some(tree) = &mut self.wide8_sah {
+            tree.refit_checked(&bvh, tris, par);
+        }
+        match wide8 {
+            Some(refitted) => self.wide8 = Some(refitted),
+            None => {
+                if let Some(tree) = &mut self.wide8 {
+                    tree.refit_checked(&bvh, tris, par);
+                }
+            }
+        }
+        timings.wide = (t3 - t2) + seconds_since(Some(t4));
+        (self.bvh, self.uncles, self.parents, self.kd, self.levels) = (bvh, uncles, parents, kd, levels);
         (self.timings, self.exponent) = (timings, exponent);
         Ok(())
     }

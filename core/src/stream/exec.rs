@@ -13,6 +13,15 @@ pub trait Parallel: Sync {
     fn sort_chunks(&self, chunks: &mut super::sort::Chunks) {
         super::sort::radix_sort(chunks);
     }
+
+    /// `f(i, piece)` for each piece `i` of `data` cut into `chunk` items (the last may be
+    /// shorter), in any order and possibly at once: for passes that write each item from data
+    /// they only read, such as a refit's ([`crate::prepared::PreparedScene::refit_with`]).
+    fn for_each_chunk<T: Send>(&self, data: &mut [T], chunk: usize, f: impl Fn(usize, &mut [T]) + Sync + Send) {
+        for (i, piece) in data.chunks_mut(chunk.max(1)).enumerate() {
+            f(i, piece);
+        }
+    }
 }
 
 /// Every item on the calling thread.

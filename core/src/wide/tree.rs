@@ -88,6 +88,12 @@ impl<const W: usize> WideBvh<W> {
         (&mut self.nodes, &self.node_ids, &self.leaf_ids)
     }
 
+    /// The canonical node ids of the inner children and of the leaves (by leaf position), for
+    /// [`WideBvh::refit`]'s check.
+    pub(super) fn canonical_ids(&self) -> (&[u32], &[u32]) {
+        (&self.node_ids, &self.leaf_ids)
+    }
+
     /// The triangles and blocks to write, with the primitive ids, for [`WideBvh::refit`].
     pub(super) fn triangles_mut(&mut self) -> (&mut [Triangle], &[u32], &mut [LeafBlock]) {
         (&mut self.triangles, &self.prims, &mut self.blocks)
