@@ -7,8 +7,8 @@ use glam::{BVec3A, Vec3, Vec3A, Vec3Swizzles};
 ///
 /// The ray is sheared so it runs along +z; edge functions are evaluated in 2D and recomputed in
 /// `f64` when one is zero or too small to trust ([`TINY_EDGE`]), so that a ray through a shared
-/// edge or vertex hits exactly one of the triangles sharing it (no cracks, no double hits). Backfaces are not culled. Where a
-/// first-order bound says the `f32` distance may be more than
+/// edge or vertex hits exactly one of the triangles sharing it (no cracks, no double hits).
+/// Backfaces are not culled. Where a first-order bound says the `f32` distance may be more than
 /// [`REFINE_ULPS`](super::REFINE_ULPS) ulps off (slanted slivers), `t` and the barycentrics are
 /// recomputed in `f64`.
 #[derive(Clone, Copy, Debug, Default)]
