@@ -55,6 +55,12 @@ fn mixed_signs_f64(u: f64, v: f64, w: f64) -> bool {
     return (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
 }
 
+// `|x|` of an f64 by a comparison, not the float built-in (`abs_bits` is the f32 rule; these
+// values, products of f32s, are normal f64s, so no flush can differ).
+fn magnitude_f64(x: f64) -> f64 {
+    return select(-x, x, x >= 0.0);
+}
+
 // `intersect::refine::needs_refine`: whether the f32 hit may be more than REFINE_ULPS ulps off, to
 // first order. `a`, `b`, `c` are the vertices relative to the origin (original axis order).
 fn tri_needs_refine(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, ax: f32, ay: f32, bx: f32, by: f32, cx: f32, cy: f32,
@@ -218,7 +224,7 @@ fn tri_intersect(a0: vec3<f32>, b0: vec3<f32>, c0: vec3<f32>, tmin: f32, tmax: f
         // least 1 / EDGE_STEP (powers of two: exact), so that none underflows when narrowed.
         let step = f64(bitcast<f32>(EDGE_STEP_BITS));
         let floor = 1.0 / step;
-        var largest = max(max(abs(u64), abs(v64)), abs(w64));
+        var largest = max(max(magnitude_f64(u64), magnitude_f64(v64)), magnitude_f64(w64));
         if largest < floor && largest != 0.0 {
             bounded = false;
             for (var i = 0u; i < 4u && largest < floor; i++) {
