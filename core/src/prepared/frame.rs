@@ -181,9 +181,8 @@ fn box_interval(ray: &Ray, b: &Aabb) -> Option<(f64, f64)> {
 
 /// Whether `ray` surely needs no change in an unscaled scene: every origin component within
 /// `far`, some direction component above `min_dir` ([`min_reliable_dir`]) and none above
-/// [`MODERATE_MAX`]. Those bound the
-/// exact decision's `reach = scale + max|origin|` by `scale + far` and its `max|d|` from below, so
-/// its slack is finite with room to spare. Only comparisons of single components, no horizontal
+/// [`MODERATE_MAX`]. Those bound the exact decision's `reach = scale + max|origin|` by
+/// `scale + far` and its `max|d|` from below, so its slack is finite with room to spare. Only comparisons of single components, no horizontal
 /// maximum and no product: a third of what the filter cost before, and it is run over every ray
 /// of a batch (`docs/notes/*-benchmarks-embree-gap.md`, "A cheaper framing filter"). A NaN origin
 /// component is never cleared; a NaN direction component may be, where another is large
