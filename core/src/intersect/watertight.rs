@@ -172,7 +172,7 @@ impl TriangleTest for Watertight {
     }
 }
 
-/// Edge functions below this magnitude are recomputed in `f64` ([`exact_edges`]), as exact zeros
+/// Edge functions below this magnitude are recomputed in `f64` (`exact_edges`), as exact zeros
 /// are in Woop, Benthin & Wald 2013. Below it an `f32` product may have underflowed (gradually on
 /// the CPU, flushed to zero on many GPUs) by more than a rounding error of the edge function, and
 /// its sign can be wrong: in a unit-size scene with vertices near `1e-37` (a fuzzed scene of
@@ -180,7 +180,7 @@ impl TriangleTest for Watertight {
 /// flushed product's error, at most `2^-126`, stays below half an ulp of the function.
 pub const TINY_EDGE: f32 = f32::from_bits((127 - 100) << 23); // 2^-100
 
-/// The step by which [`narrow_edges`] scales tiny `f64` edge functions up (and `1 / EDGE_STEP`
+/// The step by which `narrow_edges` scales tiny `f64` edge functions up (and `1 / EDGE_STEP`
 /// the magnitude it scales them to at least).
 pub const EDGE_STEP: f32 = 18_446_744_073_709_551_616.0; // 2^64
 
