@@ -8,8 +8,7 @@
 //! slot where it is and gives it its canonical node's new box.
 
 use super::leaf_block::LeafBlock;
-use super::node::WideChild;
-use super::tree::WideBvh;
+use super::tree::{canonical_of, WideBvh};
 use crate::bvh2::refit::REFIT_CHUNK;
 use crate::bvh2::Bvh2;
 use crate::geometry::Triangle;
@@ -42,13 +41,9 @@ impl<const W: usize> WideBvh<W> {
         let nodes = bvh.len();
         let (node_ids, leaf_ids) = self.canonical_ids();
         for node in self.nodes() {
-            for slot in 0..W {
-                let id = match node.child_ref(slot) {
-                    None => continue,
-                    Some(WideChild::Node(n)) => node_ids.get(n as usize),
-                    Some(WideChild::Leaf { first, .. }) => leaf_ids.get(first as usize),
-                };
-                if id.is_none_or(|&id| id as usize >= nodes) {
+            for child in (0..W).filter_map(|slot| node.child_ref(slot)) {
+                let id = canonical_of(node_ids, leaf_ids, child.node_ref());
+                if id.is_none_or(|id| id as usize >= nodes) {
                     return Err(mismatch("refit: a wide child names no node of the binary tree"));
                 }
             }
@@ -68,11 +63,8 @@ impl<const W: usize> WideBvh<W> {
             for node in piece {
                 for slot in 0..W {
                     let Some(child) = node.child_ref(slot) else { continue };
-                    let id = match child {
-                        WideChild::Node(n) => node_ids.get(n as usize),
-                        WideChild::Leaf { first, .. } => leaf_ids.get(first as usize),
-                    };
-                    if let Some(b) = id.and_then(|&id| canonical.get(id as usize)) {
+                    let id = canonical_of(node_ids, leaf_ids, child.node_ref());
+                    if let Some(b) = id.and_then(|id| canonical.get(id as usize)) {
                         node.set_child(slot, b.bounds.min, b.bounds.max, child);
                     }
                 }

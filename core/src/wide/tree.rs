@@ -150,13 +150,15 @@ impl<const W: usize> WideBvh<W> {
     /// The canonical BVH2 id of a recorded reference ([`WideChild::node_ref`]), if it names a node
     /// or leaf of this tree.
     pub fn canonical_id(&self, r: NodeRef) -> Option<u32> {
-        let id = if r.is_leaf() {
-            *self.leaf_ids.get(r.offset() as usize)?
-        } else {
-            *self.node_ids.get(r.index() as usize)?
-        };
-        (id != u32::MAX).then_some(id)
+        canonical_of(&self.node_ids, &self.leaf_ids, r)
     }
+}
+
+/// [`WideBvh::canonical_id`] from the id arrays alone ([`WideBvh::canonical_ids`]), for a pass
+/// that writes the nodes while it reads them.
+pub(super) fn canonical_of(node_ids: &[u32], leaf_ids: &[u32], r: NodeRef) -> Option<u32> {
+    let id = if r.is_leaf() { *leaf_ids.get(r.offset() as usize)? } else { *node_ids.get(r.index() as usize)? };
+    (id != u32::MAX).then_some(id)
 }
 
 /// A wide tree of either width: what a prepared scene lends a wide method, so that one match
