@@ -20,8 +20,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput};
 use embree3::{
-    BufferUsage, BuildQuality, Config, Device, Format, GeometryKind, PointQuery, PointQueryContext,
-    Scene as EmbreeScene, SceneFlags,
+    BufferUsage, BuildQuality, Config, Device, PointQuery, PointQueryContext, Scene as EmbreeScene, SceneFlags,
 };
 use rayon::prelude::*;
 use raytrail::core::nearest::closest_point_on_triangle;
@@ -29,6 +28,7 @@ use raytrail::core::prepared::PreparedScene;
 use raytrail::core::scene::Scene;
 use raytrail::cpu::CpuBackend;
 use raytrail::{Builder, TracerBuilder, AUTO_WALKS};
+use raytrail_cli::embree_mesh::{triangle_geometry, write_vertices};
 use raytrail_conformance::paths::{find_mesh, load_mesh_scene};
 use raytrail_conformance::rays::query_points;
 use raytrail_conformance::scenes::{breathing, sphereflake};
@@ -54,23 +54,7 @@ fn scenes(files: &[&str]) -> Vec<(String, Scene)> {
 /// An Embree scene of one triangle geometry at `quality`, each triangle with its own three
 /// vertices (so Embree's primitive id is raytrail's), and the geometry's id.
 fn embree_scene(device: &Device, scene: &Scene, quality: BuildQuality) -> (EmbreeScene<'static>, u32) {
-    let tris = scene.triangles();
-    let mut geometry = device.create_geometry(GeometryKind::TRIANGLE).expect("an Embree geometry");
-    {
-        let mut vertices = geometry
-            .set_new_buffer::<[f32; 3]>(BufferUsage::VERTEX, 0, Format::FLOAT3, 12, 3 * tris.len())
-            .expect("a vertex buffer");
-        write_vertices(&mut vertices, scene);
-    }
-    {
-        let mut indices = geometry
-            .set_new_buffer::<[u32; 3]>(BufferUsage::INDEX, 0, Format::UINT3, 12, tris.len())
-            .expect("an index buffer");
-        for (i, out) in indices.iter_mut().enumerate() {
-            let k = 3 * i as u32;
-            *out = [k, k + 1, k + 2];
-        }
-    }
+    let mut geometry = triangle_geometry(device, scene).expect("an Embree geometry");
     geometry.set_build_quality(quality);
     let geometry = geometry.commit();
     let mut embree = device.create_scene().expect("an Embree scene");
@@ -84,15 +68,6 @@ fn embree_scene(device: &Device, scene: &Scene, quality: BuildQuality) -> (Embre
     let id = embree.attach_geometry(&geometry);
     embree.commit();
     (embree, id)
-}
-
-/// The triangles' vertices of `scene` in Embree's unshared layout.
-fn write_vertices(out: &mut [[f32; 3]], scene: &Scene) {
-    for (out, t) in out.chunks_exact_mut(3).zip(scene.triangles()) {
-        for (o, v) in out.iter_mut().zip(&t.v) {
-            *o = v.to_array();
-        }
-    }
 }
 
 /// Embree takes a new frame: the vertices written into its buffer, marked updated, and the scene

@@ -23,10 +23,7 @@
 use super::par_trace;
 use crate::bench::report::Built;
 use crate::bench::target::{BenchTarget, TargetKind, Work};
-use embree3::{
-    BufferUsage, BuildQuality, Config, Device, Format, GeometryKind, IntersectContext, Ray as EmbreeRay, RayHit,
-    Scene as EmbreeScene,
-};
+use embree3::{BuildQuality, Config, Device, IntersectContext, Ray as EmbreeRay, RayHit, Scene as EmbreeScene};
 use raytrail::core::method::Query;
 use raytrail::core::scene::Scene;
 use raytrail::core::{Hit, Ray};
@@ -107,28 +104,8 @@ impl Embree {
             counter.fetch_add(bytes, Ordering::Relaxed);
             true
         });
-        let tris = scene.triangles();
-        let mut geometry =
-            device.create_geometry(GeometryKind::TRIANGLE).map_err(|e| fail("cannot create a geometry", e))?;
-        {
-            let mut vertices = geometry
-                .set_new_buffer::<[f32; 3]>(BufferUsage::VERTEX, 0, Format::FLOAT3, 12, 3 * tris.len())
-                .map_err(|e| fail("cannot make the vertex buffer", e))?;
-            for (out, t) in vertices.chunks_exact_mut(3).zip(tris) {
-                for (o, v) in out.iter_mut().zip(&t.v) {
-                    *o = v.to_array();
-                }
-            }
-        }
-        {
-            let mut indices = geometry
-                .set_new_buffer::<[u32; 3]>(BufferUsage::INDEX, 0, Format::UINT3, 12, tris.len())
-                .map_err(|e| fail("cannot make the index buffer", e))?;
-            for (i, out) in indices.iter_mut().enumerate() {
-                let k = 3 * i as u32;
-                *out = [k, k + 1, k + 2];
-            }
-        }
+        let geometry =
+            raytrail_cli::embree_mesh::triangle_geometry(&device, scene).map_err(|(step, e)| fail(step, e))?;
         let buffer_bytes = allocated.load(Ordering::Relaxed);
         let geometry = geometry.commit();
         let mut embree = device.create_scene().map_err(|e| fail("cannot create a scene", e))?;
