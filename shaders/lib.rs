@@ -14,6 +14,9 @@ pub struct Source {
     pub text: &'static str,
 }
 
+/// `all_hits.wgsl`.
+pub const ALL_HITS: Source = Source { name: "all_hits.wgsl", text: include_str!("all_hits.wgsl") };
+
 /// `box.wgsl`.
 pub const BOX: Source = Source { name: "box.wgsl", text: include_str!("box.wgsl") };
 
@@ -194,6 +197,7 @@ pub const WIDE_TRAIL: Source = Source { name: "wide_trail.wgsl", text: include_s
 
 /// Every file, in name order.
 pub const ALL: &[Source] = &[
+    ALL_HITS,
     BOX,
     BVH_LEAF,
     BVH_PARENT_SIBLING,

@@ -60,8 +60,10 @@ struct Params {
     // and the steps a stream takes in one round before it saves its state for the next.
     stream_round: u32,
     stream_steps: u32,
-    pad0: u32,
-    pad1: u32,
+    // The all-hits kernel (all_hits.wgsl): hits a list keeps (the caller's limit and one more),
+    // and whether hits at one t count once (nonzero).
+    all_hits_keep: u32,
+    all_hits_merge: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;

@@ -5,19 +5,11 @@
 
 use raytrail::core::scene::Scene;
 use raytrail::{AllHitsOptions, Hit, Ray, Tracer, TracerBuilder, Vec3};
-use raytrail_conformance::all_hits::{brute_force_mismatches, exact_mismatches};
+use raytrail_conformance::all_hits::{brute_force_mismatches, exact_mismatches, OPTIONS};
 use raytrail_conformance::rays::{ray_sets, RaySetSize};
 use raytrail_conformance::scenes::{far_from_origin, shared_edge_grid, sphereflake, triangle_soup};
 
 const SIZE: RaySetSize = RaySetSize { width: 24, height: 18, uniform_count: 256 };
-
-/// Every option the lists are checked under.
-const OPTIONS: [AllHitsOptions; 4] = [
-    AllHitsOptions { max_hits: usize::MAX, merge_equal_t: false },
-    AllHitsOptions { max_hits: 2, merge_equal_t: false },
-    AllHitsOptions { max_hits: usize::MAX, merge_equal_t: true },
-    AllHitsOptions { max_hits: 1, merge_equal_t: true },
-];
 
 fn scenes() -> Vec<(&'static str, Scene)> {
     vec![

@@ -9,17 +9,27 @@
 //!   the hit lies within it of the interval's ends.
 //!
 //! The exact check goes over every triangle for every ray: it is for small scenes.
+//!
+//! [`check_backend`] is the conformance suite's all-hits case ([`crate::suite::Case::AllHits`]):
+//! both checks on a backend's lists ([`Trace::all_hits`]) under every option of [`OPTIONS`].
 
 use crate::exact::filter::{filter, margin, Filtered};
 use crate::exact::triangle::exact_hit;
 use crate::exact::Tolerance;
+use crate::rays::{ray_sets, RaySetSize};
+use crate::reference::SerialBackend;
+use crate::scenes::{self, NamedScene};
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
+use raytrail_core::bvh2::{Bvh2, SahBuilder, SbvhBuilder};
 use raytrail_core::geometry::Triangle;
 use raytrail_core::intersect::{TriangleTest, Watertight};
+use raytrail_core::method::{Bvh2Method, Method, WideMethod};
 use raytrail_core::prepared::PreparedScene;
+use raytrail_core::trace::{Trace, TraceOptions};
 use raytrail_core::traverse::begin_slab;
 use raytrail_core::wide::WideTree;
 use raytrail_core::{Hit, Ray};
+use std::sync::Arc;
 
 /// The triangles of `prepared` by primitive id, in its frame (scaled as it was prepared), from
 /// the wide tree the all-hits walk reads.
@@ -141,4 +151,80 @@ pub fn exact_mismatches(triangles: &[Triangle], scene_scale: f32, rays: &[Ray], 
         }
     }
     out
+}
+
+/// Every option lists are checked under: all hits, a limit of two, merged at equal `t`, and merged
+/// with a limit of one.
+pub const OPTIONS: [AllHitsOptions; 4] = [
+    AllHitsOptions { max_hits: usize::MAX, merge_equal_t: false },
+    AllHitsOptions { max_hits: 2, merge_equal_t: false },
+    AllHitsOptions { max_hits: usize::MAX, merge_equal_t: true },
+    AllHitsOptions { max_hits: 1, merge_equal_t: true },
+];
+
+/// Rays of the all-hits case per scene: every kind of the suite's ray sets, fewer of each than
+/// the methods' cases trace (both checks go over every triangle for every ray).
+const RAYS: RaySetSize = RaySetSize { width: 24, height: 18, uniform_count: 256 };
+
+/// The suite's all-hits case on `backend`: the shared-edge grid, the sphereflake (with a SAH and
+/// a split tree, whose cut triangles lie in several leaves), the triangle soup and the scene far
+/// from the origin, the first three smaller than the methods' cases have them, each prepared as the default tracer prepares a scene (its 8-wide tree of
+/// least node area). Under every option of [`OPTIONS`] the lists must be the brute force's bit
+/// for bit, and the complete ones must agree with the exact reference; panics with a loud report
+/// otherwise, or when the backend has no all-hits query.
+pub fn check_backend<B: Trace>(backend: &B) {
+    let sah = |s: &NamedScene| SahBuilder::default().build(s.scene.triangles()).expect("SAH build");
+    let sbvh = |s: &NamedScene| SbvhBuilder::default().build(s.scene.triangles()).expect("SBVH build");
+    let sphereflake = NamedScene::new("sphereflake", scenes::sphereflake(2));
+    check_scene(backend, &NamedScene::new("shared_edge_grid", scenes::shared_edge_grid(8)), sah);
+    check_scene(backend, &sphereflake, sah);
+    let split = sbvh(&sphereflake);
+    assert!(split.has_split_references(), "the sphereflake's SBVH tree should cut triangles");
+    check_scene(backend, &sphereflake, |_| split);
+    check_scene(backend, &NamedScene::new("triangle_soup", scenes::triangle_soup(1500, 7)), sah);
+    check_scene(backend, &NamedScene::new("far_from_origin", scenes::far_from_origin()), sah);
+}
+
+/// [`check_backend`] on one scene with the tree `build` makes.
+fn check_scene<B: Trace>(backend: &B, named: &NamedScene, build: impl FnOnce(&NamedScene) -> Bvh2) {
+    let methods = [Method::Bvh2(Bvh2Method::Stack), Method::Wide(WideMethod::BVH8_SAH)];
+    let prepared = Arc::new(PreparedScene::new(&named.scene, build(named), &methods).expect("prepare"));
+    let serial = SerialBackend;
+    let mut closest = |rays: &[Ray]| {
+        let mut hits = vec![Hit::MISS; rays.len()];
+        serial.trace(&prepared, rays, &TraceOptions::new(Bvh2Method::Stack), &mut hits).expect("serial trace");
+        hits
+    };
+    let rays: Vec<Ray> = ray_sets(&named.scene, RAYS, &mut closest).into_iter().flat_map(|s| s.rays).collect();
+    let scene = backend.prepare(prepared.clone()).expect("prepare on the backend");
+    for options in &OPTIONS {
+        let what = format!("backend {}, scene {}, {options:?}", backend.name(), named.name);
+        let lists = backend
+            .all_hits(&scene, &rays, options)
+            .unwrap_or_else(|e| panic!("NOT CONFORMING: {what}: all hits failed: {e}"));
+        // Complete lists of a few hits each at least, so that order, merging and cuts are
+        // exercised.
+        let (hits, long) = (lists.hits().len(), lists.iter().filter(|l| l.len() > 2).count());
+        let complete = *options == OPTIONS[0];
+        assert!(!complete || (hits > rays.len() / 4 && long > 0), "{what}: {hits} hits, {long} lists of more than two");
+        let wrong = brute_force_mismatches(&prepared, &rays, options, &lists);
+        assert!(
+            wrong.is_empty(),
+            "NOT CONFORMING: {what}: {} of {} rays' lists differ from the brute force's: {:?}",
+            wrong.len(),
+            rays.len(),
+            &wrong[..wrong.len().min(3)]
+        );
+        // Far from the origin, the adversarial rays' tiny directions put exact distances past
+        // f32's range (1e40 and more), which a float list holds as t = inf.
+        if complete && named.name != "far_from_origin" {
+            let wrong = exact_mismatches(named.scene.triangles(), named.scene.bounds().max_abs(), &rays, &lists);
+            assert!(
+                wrong.is_empty(),
+                "NOT CONFORMING: {what}: {} disagreements with the exact reference: {:?}",
+                wrong.len(),
+                &wrong[..wrong.len().min(3)]
+            );
+        }
+    }
 }

@@ -2,6 +2,7 @@
 //! entry points and nothing else. It is the suite's yardstick for other backends (each is compared
 //! with it ray by ray), and the smallest example of a backend.
 
+use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::bvh2::traverse::trace_ray;
 use raytrail_core::intersect::{MollerTrumbore, TriangleTest, Watertight};
 use raytrail_core::kd::traverse::packets::packets;
@@ -204,6 +205,11 @@ impl Trace for SerialBackend {
         hits: &mut [Hit],
     ) -> Result<Report, Error> {
         raytrail_core::trace::trace_framed(scene, rays, hits, |rays, hits| self.trace_in_frame(scene, rays, opts, hits))
+    }
+
+    /// The core's walk, one ray after another.
+    fn all_hits(&self, scene: &Arc<PreparedScene>, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
+        AllHits::trace(scene, rays, options)
     }
 }
 

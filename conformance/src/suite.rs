@@ -65,6 +65,9 @@ pub enum Case {
     /// Instances of three generated meshes against their flattened triangles
     /// ([`crate::instanced`]).
     Instanced,
+    /// Every hit along each ray ([`Trace::all_hits`]) against a brute force and the exact
+    /// reference, under every option ([`crate::all_hits::check_backend`]).
+    AllHits,
 }
 
 /// Runs one case on `backend`; panics with a loud report on any mismatch.
@@ -123,6 +126,7 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
             check_refit(backend, &s, sbvh, REFIT_RAYS);
         }
         Case::Instanced => check_instanced(backend),
+        Case::AllHits => crate::all_hits::check_backend(backend),
     }
 }
 
@@ -368,6 +372,7 @@ macro_rules! conformance_suite {
             far_from_origin => FarFromOrigin,
             tiny_cases => TinyCases,
             instanced => Instanced,
+            all_hits => AllHits,
             cornell_box => Mesh("cornell_box.obj"),
             teapot => Mesh("teapot.obj"),
         );

@@ -1,5 +1,6 @@
 //! The backend-agnostic trace API: what every backend implements and every caller uses.
 
+use crate::all_hits::{AllHits, AllHitsOptions};
 use crate::method::{Method, Query};
 use crate::observe::Counters;
 use crate::prepared::PreparedScene;
@@ -200,6 +201,15 @@ pub trait Trace: Send + Sync {
         options: &TraceOptions,
         hits: &mut [Hit],
     ) -> Result<Report, Error>;
+
+    /// Every hit of each of `rays` in order of `t`, each triangle once, as `options` keep them
+    /// ([`crate::all_hits`]): the lists the core's walk makes ([`AllHits::trace`]), bit for bit,
+    /// which the conformance suite holds every backend to. A backend without the query keeps this
+    /// default, [`Error::Unsupported`], and the suite reports it as not conforming.
+    fn all_hits(&self, scene: &Self::Prepared, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
+        let _ = (scene, rays, options);
+        Err(Error::Unsupported { method: "all hits", by: "this backend" })
+    }
 }
 
 #[cfg(test)]

@@ -22,6 +22,7 @@ pub fn variants_for(keys: KeyWidth, chosen: &[(Method, Query)]) -> Vec<Variant> 
             record: Record::Nothing,
             dispatch: DispatchKind::of(config.dispatch, method),
             workgroup_size: config.workgroup_size,
+            all_hits: false,
         };
         if !out.contains(&v) {
             out.push(v);

@@ -11,10 +11,15 @@ use raytrail_core::{Error, Ray};
 const CHUNK: usize = 256;
 
 impl CpuBackend {
-    /// Every hit of each of `rays` in `scene`, in order of `t` and as `options` keep them, traced
-    /// on this backend's threads. [`Error::NotPrepared`] for a scene without a wide tree (one
-    /// prepared only for BVH2, kd or stream methods).
-    pub fn all_hits(&self, scene: &CpuScene, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
+    /// [`Trace::all_hits`](raytrail_core::trace::Trace::all_hits) on this backend's threads.
+    /// [`Error::NotPrepared`] for a scene without a wide tree (one prepared only for BVH2, kd or
+    /// stream methods).
+    pub(crate) fn trace_all_hits(
+        &self,
+        scene: &CpuScene,
+        rays: &[Ray],
+        options: &AllHitsOptions,
+    ) -> Result<AllHits, Error> {
         let prepared = &scene.0;
         // Fails here, once, for a scene without a wide tree.
         prepared.query_tree()?;

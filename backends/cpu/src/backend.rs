@@ -1,5 +1,6 @@
 use crate::chunk::Chunk;
 use rayon::prelude::*;
+use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::method::Method;
 use raytrail_core::method::WideWalk;
 use raytrail_core::observe::Counters;
@@ -89,6 +90,11 @@ impl Trace for CpuBackend {
             self.trace_in_frame(scene, rays, opts, hits, Framing::Done)?
                 .ok_or_else(|| Error::Device { backend: "cpu", detail: "framed rays asked for framing again".into() })
         })
+    }
+
+    /// Chunks of rays on the backend's threads, their lists joined in ray order.
+    fn all_hits(&self, scene: &CpuScene, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
+        self.trace_all_hits(scene, rays, options)
     }
 }
 

@@ -9,6 +9,7 @@ use crate::record;
 use crate::scene::WgpuScene;
 use crate::stream::kernels::StreamKernels;
 use crate::workspace::bytes_moved;
+use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::bvh2::NodeRef;
 use raytrail_core::method::Method;
 use raytrail_core::observe::Counters;
@@ -176,6 +177,11 @@ impl Trace for WgpuBackend {
         raytrail_core::trace::trace_framed(&scene.prepared, rays, hits, |rays, hits| {
             self.trace_in_frame(scene, rays, options, hits)
         })
+    }
+
+    /// A hit list per ray on the device (shaders/all_hits.wgsl), on the tree the core's walk reads.
+    fn all_hits(&self, scene: &WgpuScene, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
+        self.trace_all_hits(scene, rays, options)
     }
 }
 

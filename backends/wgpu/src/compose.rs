@@ -48,6 +48,7 @@ const KD_STACK: Part = part!(KD_STACK);
 const KD_RESTART: Part = part!(KD_RESTART);
 const KD_PACKET: Part = part!(KD_PACKET);
 const ENTRY: Part = part!(ENTRY);
+const ALL_HITS: Part = part!(ALL_HITS);
 const DISPATCH_GRID: Part = part!(DISPATCH_GRID);
 const DISPATCH_PERSISTENT: Part = part!(DISPATCH_PERSISTENT);
 const WIDE: Part = part!(WIDE);
@@ -73,6 +74,9 @@ pub struct Variant {
     pub dispatch: DispatchKind,
     /// Invocations per workgroup (the `WORKGROUP_SIZE` override).
     pub workgroup_size: u32,
+    /// Every hit along each ray (`all_hits.wgsl`, a list per ray) instead of `query`'s answer:
+    /// for the wide stack walk's methods only.
+    pub all_hits: bool,
 }
 
 /// The dispatch file of a kernel: what [`Dispatch`] compiles to (the number of persistent
@@ -100,7 +104,8 @@ impl Variant {
     /// The variant's name, for labels and messages.
     pub fn label(&self) -> String {
         format!(
-            "{}/{}/{}/{}/{:?}/{:?}/{}",
+            "{}{}/{}/{}/{}/{:?}/{:?}/{}",
+            if self.all_hits { "all-hits/" } else { "" },
             self.method.name(),
             if self.keys == KeyWidth::W64 { "k64" } else { "k32" },
             match self.triangle {
@@ -116,6 +121,9 @@ impl Variant {
 
     /// The WGSL files of this kernel, in order; [`Error::Unsupported`] for a method without one.
     pub fn parts(&self) -> Result<Vec<Part>, Error> {
+        if self.all_hits {
+            return self.all_hits_parts();
+        }
         let mut parts = self.method_parts()?;
         // The stream method's intersection kernel has its own entry point.
         if let Method::Stream(_) = self.method {
@@ -135,6 +143,24 @@ impl Variant {
             DispatchKind::Persistent => DISPATCH_PERSISTENT,
         });
         Ok(parts)
+    }
+
+    /// The all-hits kernel's files: the wide stack walk's, with `all_hits` as the query and the
+    /// work items; [`Error::Unsupported`] for a method of another walk.
+    fn all_hits_parts(&self) -> Result<Vec<Part>, Error> {
+        if !self.method.wide().is_some_and(|m| m.walk() == WideWalk::Stack) {
+            return Err(Error::Unsupported {
+                method: self.method.name(),
+                by: "the all-hits kernel (wide stack walks)",
+            });
+        }
+        let parts = self.method_parts()?.into_iter().map(|p| if p == QUERY { ALL_HITS } else { p });
+        Ok(parts
+            .chain([match self.dispatch {
+                DispatchKind::Grid => DISPATCH_GRID,
+                DispatchKind::Persistent => DISPATCH_PERSISTENT,
+            }])
+            .collect())
     }
 
     /// The files up to and including the method's, without work items or a dispatch file (the
@@ -285,6 +311,7 @@ pub fn all_variants(keys: KeyWidth) -> impl Iterator<Item = Variant> {
                         record,
                         dispatch,
                         workgroup_size: crate::GpuConfig::default().workgroup_size,
+                        all_hits: false,
                     })
                 })
             })
@@ -336,6 +363,36 @@ mod tests {
         assert_eq!(n, 2 * Method::ALL.len() * 2 * 2 * 3 * 2);
     }
 
+    /// The all-hits kernel of every wide stack walk validates under both dispatch files; every
+    /// other method is refused by name.
+    #[test]
+    fn all_hits_kernels_validate_for_the_wide_stack_walks_and_only_for_them() {
+        let variant = |method: Method, dispatch| Variant {
+            method,
+            keys: KeyWidth::W32,
+            triangle: TriangleTestKind::Watertight,
+            query: Query::Closest,
+            record: Record::Nothing,
+            dispatch,
+            workgroup_size: 64,
+            all_hits: true,
+        };
+        let mut walks = 0;
+        for method in Method::ALL {
+            for dispatch in [DispatchKind::Grid, DispatchKind::Persistent] {
+                let v = variant(method, dispatch);
+                if method.wide().is_some_and(|m| m.walk() == WideWalk::Stack) {
+                    validate(&v).unwrap_or_else(|e| panic!("{}:\n{e}", v.label()));
+                    assert!(v.source().unwrap().contains("shaders/all_hits.wgsl"));
+                    walks += 1;
+                } else {
+                    assert!(matches!(v.source(), Err(Error::Unsupported { .. })), "{}", v.label());
+                }
+            }
+        }
+        assert_eq!(walks, 2 * 4, "bvh4, bvh8, bvh4-naive and bvh8-sah, two dispatch files each");
+    }
+
     /// The kernel cache (pipelines.rs) compiles once per distinct text: methods that differ only
     /// in their tree share a kernel, and methods that walk differently never do.
     #[test]
@@ -349,6 +406,7 @@ mod tests {
                 record: Record::Nothing,
                 dispatch: DispatchKind::Grid,
                 workgroup_size: 64,
+                all_hits: false,
             };
             (v.source().expect("a kernel"), v.overrides())
         };

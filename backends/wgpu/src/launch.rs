@@ -31,6 +31,7 @@ pub(crate) fn variant(scene: &WgpuScene, options: &TraceOptions, config: &GpuCon
         record: options.record,
         dispatch: DispatchKind::of(config.dispatch, options.method),
         workgroup_size: config.workgroup_size,
+        all_hits: false,
     }
 }
 

@@ -15,6 +15,7 @@
 //! conformance suite) then go on with the CPU backend.
 #![warn(missing_docs)]
 
+mod all_hits;
 mod backend;
 mod batch;
 pub mod compose;

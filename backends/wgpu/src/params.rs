@@ -30,7 +30,10 @@ pub(crate) struct Params {
     /// a stream takes in one round before it saves its state for the next.
     pub stream_round: u32,
     pub stream_steps: u32,
-    pub pad: [u32; 2],
+    /// The all-hits kernel: hits a list keeps (the caller's limit and one more), and whether hits
+    /// at one `t` count once (1) or not (0).
+    pub all_hits_keep: u32,
+    pub all_hits_merge: u32,
 }
 
 #[cfg(test)]

@@ -40,6 +40,14 @@ impl AllHits {
         Ok(out)
     }
 
+    /// Appends the list of one more ray: `hits` in order of `(t, prim)`, and whether it was cut
+    /// at the limit (for a backend that makes the lists itself).
+    pub fn push(&mut self, hits: &[Hit], truncated: bool) {
+        self.hits.extend_from_slice(hits);
+        self.offsets.push(self.hits.len());
+        self.truncated.push(truncated);
+    }
+
     /// Appends the lists of `other` (the rays after these).
     pub fn append(&mut self, other: AllHits) {
         let base = self.hits.len();

@@ -88,22 +88,30 @@ impl FramedRays<'_> {
     /// and returns how many rays were refused.
     pub fn finish(&self, hits: &mut [Hit]) -> usize {
         let mut refused = 0;
-        for (hit, fix) in hits.iter_mut().zip(&self.fixes) {
-            match *fix {
-                Fix::Keep => {}
-                Fix::Moved(t0, exp) => {
-                    if hit.is_hit() {
-                        hit.t = scale_pow2((f64::from(t0) + f64::from(hit.t)) as f32, exp);
-                    }
-                }
-                Fix::Miss => *hit = Hit::MISS,
-                Fix::Refused => {
-                    *hit = Hit::REFUSED;
-                    refused += 1;
-                }
-            }
+        for (i, hit) in hits.iter_mut().enumerate().take(self.fixes.len()) {
+            refused += usize::from(self.finish_ray(i, hit));
         }
         refused
+    }
+
+    /// Puts one hit of ray `i` back in the caller's frame, as [`FramedRays::finish`] does for a
+    /// batch's hits (a query that finds several hits per ray puts back each); returns whether
+    /// the ray was refused (the hit is then [`Hit::REFUSED`]).
+    pub fn finish_ray(&self, i: usize, hit: &mut Hit) -> bool {
+        match self.fixes.get(i).copied().unwrap_or(Fix::Keep) {
+            Fix::Keep => {}
+            Fix::Moved(t0, exp) => {
+                if hit.is_hit() {
+                    hit.t = scale_pow2((f64::from(t0) + f64::from(hit.t)) as f32, exp);
+                }
+            }
+            Fix::Miss => *hit = Hit::MISS,
+            Fix::Refused => {
+                *hit = Hit::REFUSED;
+                return true;
+            }
+        }
+        false
     }
 }
 

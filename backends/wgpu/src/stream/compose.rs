@@ -82,6 +82,7 @@ impl StreamKernel {
             // Its own entry point: these two are not used.
             dispatch: Default::default(),
             workgroup_size: crate::GpuConfig::default().workgroup_size,
+            all_hits: false,
         })
     }
 

@@ -1,0 +1,164 @@
+//! Every hit along each ray on the device ([`Trace::all_hits`]): the wide stack walk with a hit
+//! list per ray for an answer (shaders/all_hits.wgsl), on the tree the core's all-hits walk reads,
+//! the lists read back from the rays' record slots and put back in the caller's frame as the core
+//! puts them ([`raytrail_core::all_hits::all_hits_framed`]).
+//!
+//! A slot holds [`FIRST_SLOT_HITS`] hits on the first trace. A ray whose list fills its slot while
+//! the caller's limit allows more may have lost hits: it is traced again with a slot four times as
+//! large, until no list fills its slot. A list never holds more hits than the tree has triangle
+//! references, so a slot one larger than that is never filled, and the rounds end.
+//!
+//! [`Trace::all_hits`]: raytrail_core::trace::Trace::all_hits
+
+use crate::batch;
+use crate::compose::{DispatchKind, Variant};
+use crate::config::{Dispatch, GpuConfig};
+use crate::device::device_error;
+use crate::launch;
+use crate::scene::WgpuScene;
+use crate::WgpuBackend;
+use raytrail_core::all_hits::{AllHits, AllHitsOptions};
+use raytrail_core::key::KeyWidth;
+use raytrail_core::method::{Method, Query, WideMethod};
+use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
+use raytrail_core::wide::WideTree;
+use raytrail_core::{Error, Hit, Ray};
+
+/// Hits a ray's slot holds on the first trace: a ray crosses a closed mesh an even number of
+/// times, and most rays of a scene cross few surfaces.
+const FIRST_SLOT_HITS: usize = 8;
+
+/// Rays traced and read back at once: their slots on the host stay within a few megabytes
+/// (132 bytes a ray at the first slot size).
+const CHUNK_RAYS: usize = 1 << 16;
+
+/// The methods whose trees the core's all-hits walk reads, in the order it prefers them
+/// ([`raytrail_core::prepared::PreparedScene::query_tree`]): the GPU walks the same tree.
+const QUERY_TREES: [WideMethod; 4] = [WideMethod::BVH8_SAH, WideMethod::BVH8, WideMethod::BVH4, WideMethod::BVH4_NAIVE];
+
+impl WgpuBackend {
+    /// [`Trace::all_hits`](raytrail_core::trace::Trace::all_hits) on the device.
+    pub(crate) fn trace_all_hits(
+        &self,
+        scene: &WgpuScene,
+        rays: &[Ray],
+        options: &AllHitsOptions,
+    ) -> Result<AllHits, Error> {
+        let prepared = &scene.prepared;
+        // Fails here, with the core's reason, for a scene without a wide tree.
+        prepared.query_tree()?;
+        let method = QUERY_TREES
+            .into_iter()
+            .find(|&m| prepared.wide_root(m).is_ok())
+            .ok_or(Error::NotPrepared { method: "all hits", missing: "a wide tree" })?;
+        let references = match prepared.wide_tree(method)? {
+            WideTree::Four(t) => t.triangles().len(),
+            WideTree::Eight(t) => t.triangles().len(),
+        };
+        // The list keeps the caller's limit and one more, whose presence says it was cut.
+        let keep = options.max_hits.saturating_add(1);
+        let lists = Lists { method, keep, largest_slot: keep.min(references + 1), merge: options.merge_equal_t };
+        let framed = prepared.frame_rays(rays);
+        let mut out = AllHits::default();
+        for (c, chunk) in framed.rays().chunks(CHUNK_RAYS).enumerate() {
+            let base = c * CHUNK_RAYS;
+            for (k, mut list) in self.lists(scene, &lists, chunk)?.into_iter().enumerate() {
+                let mut probe = Hit::MISS;
+                if framed.finish_ray(base + k, &mut probe) {
+                    out.push(&[Hit::REFUSED], false);
+                    continue;
+                }
+                let truncated = list.len() > options.max_hits;
+                list.truncate(options.max_hits);
+                for hit in &mut list {
+                    framed.finish_ray(base + k, hit);
+                }
+                out.push(&list, truncated);
+            }
+        }
+        Ok(out)
+    }
+
+    /// The lists of `rays` (in the scene's frame), each of up to `lists.keep` hits, in order.
+    fn lists(&self, scene: &WgpuScene, lists: &Lists, rays: &[Ray]) -> Result<Vec<Vec<Hit>>, Error> {
+        let mut out = vec![Vec::new(); rays.len()];
+        let mut todo: Vec<usize> = (0..rays.len()).collect();
+        let mut slot = FIRST_SLOT_HITS.min(lists.largest_slot);
+        loop {
+            let traced: Vec<Ray> = todo.iter().map(|&i| rays[i]).collect();
+            let records = self.trace_lists(scene, lists, &traced, slot)?;
+            let stride = 1 + 4 * slot;
+            let mut again = Vec::new();
+            for (k, &i) in todo.iter().enumerate() {
+                let words = &records[k * stride..(k + 1) * stride];
+                let held = words[0] as usize;
+                if held > slot {
+                    return Err(device_error(format!("ray {i}'s hit list holds {held} hits in a slot of {slot}")));
+                }
+                if held == slot && slot < lists.largest_slot {
+                    again.push(i);
+                    continue;
+                }
+                out[i] = words[1..1 + 4 * held]
+                    .chunks_exact(4)
+                    .map(|w| Hit {
+                        t: f32::from_bits(w[0]),
+                        prim: w[1],
+                        u: f32::from_bits(w[2]),
+                        v: f32::from_bits(w[3]),
+                    })
+                    .collect();
+            }
+            if again.is_empty() {
+                return Ok(out);
+            }
+            todo = again;
+            slot = slot.saturating_mul(4).min(lists.largest_slot);
+        }
+    }
+
+    /// Traces `rays` with slots of `slot` hits; returns every ray's slot, in ray order.
+    fn trace_lists(&self, scene: &WgpuScene, lists: &Lists, rays: &[Ray], slot: usize) -> Result<Vec<u32>, Error> {
+        let stride = 1 + 4 * slot;
+        let binding = self.gpu.limits.max_storage_buffer_binding_size.min(self.gpu.limits.max_buffer_size);
+        if 4 * stride as u64 > binding {
+            return Err(device_error(format!(
+                "a ray's list of {slot} hits exceeds the device's largest binding ({binding} bytes): ask \
+                 for fewer hits per ray (max_hits)"
+            )));
+        }
+        let variant = Variant {
+            method: Method::Wide(lists.method),
+            keys: KeyWidth::W32,
+            triangle: TriangleTestKind::Watertight,
+            query: Query::Closest,
+            record: Record::Nothing,
+            dispatch: DispatchKind::Grid,
+            workgroup_size: self.config.workgroup_size,
+            all_hits: true,
+        };
+        let pipeline = self.pipelines.get(&self.gpu, &variant)?;
+        let options = TraceOptions::new(lists.method);
+        let config = GpuConfig { dispatch: Dispatch::Grid, ..self.config };
+        let mut launch = launch::launch(scene, &options, slot, &pipeline, &self.pipelines.bind_layout, config)?;
+        launch.params.record_stride = stride as u32;
+        launch.params.record_cap = slot as u32;
+        launch.params.all_hits_keep = lists.keep.min(u32::MAX as usize) as u32;
+        launch.params.all_hits_merge = u32::from(lists.merge);
+        let mut ws = scene.workspace()?;
+        let mut hits = vec![Hit::MISS; rays.len()];
+        Ok(batch::run(&self.gpu, &mut ws, &launch, rays, &mut hits)?.records)
+    }
+}
+
+/// What every trace of one all-hits call shares.
+struct Lists {
+    /// The method whose tree is walked.
+    method: WideMethod,
+    /// Hits a list keeps: the caller's limit and one more.
+    keep: usize,
+    /// The largest slot a ray needs: the keep, or one more than the tree's triangle references.
+    largest_slot: usize,
+    /// Whether hits at one `t` count once.
+    merge: bool,
+}
