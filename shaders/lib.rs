@@ -77,6 +77,9 @@ pub const KEYS32: Source = Source { name: "keys32.wgsl", text: include_str!("key
 /// `keys64.wgsl`.
 pub const KEYS64: Source = Source { name: "keys64.wgsl", text: include_str!("keys64.wgsl") };
 
+/// `nearest.wgsl`.
+pub const NEAREST: Source = Source { name: "nearest.wgsl", text: include_str!("nearest.wgsl") };
+
 /// `numerics.wgsl`.
 pub const NUMERICS: Source = Source { name: "numerics.wgsl", text: include_str!("numerics.wgsl") };
 
@@ -217,6 +220,7 @@ pub const ALL: &[Source] = &[
     KD_STACK,
     KEYS32,
     KEYS64,
+    NEAREST,
     NUMERICS,
     PRELUDE,
     PROBE,

@@ -10,6 +10,7 @@ use raytrail_core::kd::traverse::{trace_kd_packet, trace_kd_ray, RestartPolicy, 
 use raytrail_core::key::{Key, KeyWidth};
 use raytrail_core::method::WideWalk;
 use raytrail_core::method::{KdMethod, Method, Query, StreamMethod, WideMethod};
+use raytrail_core::nearest::NearestPoint;
 use raytrail_core::observe::{Both, Counters, Recorder};
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::stream::{trace_stream_with, FrustumCull, Serial};
@@ -210,6 +211,16 @@ impl Trace for SerialBackend {
     /// The core's walk, one ray after another.
     fn all_hits(&self, scene: &Arc<PreparedScene>, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
         AllHits::trace(scene, rays, options)
+    }
+
+    /// The core's walk, one point after another.
+    fn nearest_points(
+        &self,
+        scene: &Arc<PreparedScene>,
+        points: &[[f32; 3]],
+        radius: f32,
+    ) -> Result<Vec<Option<NearestPoint>>, Error> {
+        raytrail_core::nearest::nearest_points(scene, points, radius)
     }
 }
 

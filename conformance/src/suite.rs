@@ -68,6 +68,9 @@ pub enum Case {
     /// Every hit along each ray ([`Trace::all_hits`]) against a brute force and the exact
     /// reference, under every option ([`crate::all_hits::check_backend`]).
     AllHits,
+    /// The nearest point on the mesh ([`Trace::nearest_points`]) against a brute force
+    /// ([`crate::nearest::check_backend`]).
+    Nearest,
 }
 
 /// Runs one case on `backend`; panics with a loud report on any mismatch.
@@ -127,6 +130,7 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
         }
         Case::Instanced => check_instanced(backend),
         Case::AllHits => crate::all_hits::check_backend(backend),
+        Case::Nearest => crate::nearest::check_backend(backend),
     }
 }
 
@@ -373,6 +377,7 @@ macro_rules! conformance_suite {
             tiny_cases => TinyCases,
             instanced => Instanced,
             all_hits => AllHits,
+            nearest => Nearest,
             cornell_box => Mesh("cornell_box.obj"),
             teapot => Mesh("teapot.obj"),
         );

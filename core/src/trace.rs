@@ -2,6 +2,7 @@
 
 use crate::all_hits::{AllHits, AllHitsOptions};
 use crate::method::{Method, Query};
+use crate::nearest::NearestPoint;
 use crate::observe::Counters;
 use crate::prepared::PreparedScene;
 use crate::stream::{StreamParams, StreamStats};
@@ -209,6 +210,21 @@ pub trait Trace: Send + Sync {
     fn all_hits(&self, scene: &Self::Prepared, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
         let _ = (scene, rays, options);
         Err(Error::Unsupported { method: "all hits", by: "this backend" })
+    }
+
+    /// The point of the mesh nearest to each of `points` within distance `radius` (`None` where
+    /// no triangle comes that close, or for a point that is not finite; [`crate::nearest`]): the
+    /// core's answers ([`crate::nearest::nearest_points`]), bit for bit, which the conformance
+    /// suite holds every backend to. A backend without the query keeps this default,
+    /// [`Error::Unsupported`], and the suite reports it as not conforming.
+    fn nearest_points(
+        &self,
+        scene: &Self::Prepared,
+        points: &[[f32; 3]],
+        radius: f32,
+    ) -> Result<Vec<Option<NearestPoint>>, Error> {
+        let _ = (scene, points, radius);
+        Err(Error::Unsupported { method: "nearest points", by: "this backend" })
     }
 }
 

@@ -3,7 +3,7 @@
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Method, Query};
 use raytrail_core::trace::{Record, TriangleTestKind};
-use raytrail_wgpu::compose::{all_variants, DispatchKind, Variant};
+use raytrail_wgpu::compose::{all_variants, Answer, DispatchKind, Variant};
 use raytrail_wgpu::GpuConfig;
 
 /// The kernels tracing compiles for `chosen` (a method per query) on a tree with `keys`: one per
@@ -22,7 +22,7 @@ pub fn variants_for(keys: KeyWidth, chosen: &[(Method, Query)]) -> Vec<Variant> 
             record: Record::Nothing,
             dispatch: DispatchKind::of(config.dispatch, method),
             workgroup_size: config.workgroup_size,
-            all_hits: false,
+            answer: Answer::Hit,
         };
         if !out.contains(&v) {
             out.push(v);

@@ -3,6 +3,7 @@ use rayon::prelude::*;
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::method::Method;
 use raytrail_core::method::WideWalk;
+use raytrail_core::nearest::NearestPoint;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
@@ -95,6 +96,16 @@ impl Trace for CpuBackend {
     /// Chunks of rays on the backend's threads, their lists joined in ray order.
     fn all_hits(&self, scene: &CpuScene, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
         self.trace_all_hits(scene, rays, options)
+    }
+
+    /// Chunks of points on the backend's threads.
+    fn nearest_points(
+        &self,
+        scene: &CpuScene,
+        points: &[[f32; 3]],
+        radius: f32,
+    ) -> Result<Vec<Option<NearestPoint>>, Error> {
+        self.trace_nearest_points(scene, points, radius)
     }
 }
 

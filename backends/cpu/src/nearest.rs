@@ -10,10 +10,9 @@ use raytrail_core::Error;
 const CHUNK: usize = 256;
 
 impl CpuBackend {
-    /// The point of `scene`'s mesh nearest to each of `points` within distance `radius`
-    /// (`None` where no triangle comes that close, or for a point that is not finite), on this
-    /// backend's threads. [`Error::NotPrepared`] for a scene without a wide tree.
-    pub fn nearest_points(
+    /// [`Trace::nearest_points`](raytrail_core::trace::Trace::nearest_points) on this backend's
+    /// threads. [`Error::NotPrepared`] for a scene without a wide tree.
+    pub(crate) fn trace_nearest_points(
         &self,
         scene: &CpuScene,
         points: &[[f32; 3]],

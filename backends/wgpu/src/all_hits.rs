@@ -10,17 +10,13 @@
 //!
 //! [`Trace::all_hits`]: raytrail_core::trace::Trace::all_hits
 
-use crate::batch;
-use crate::compose::{DispatchKind, Variant};
-use crate::config::{Dispatch, GpuConfig};
+use crate::compose::Answer;
 use crate::device::device_error;
-use crate::launch;
 use crate::scene::WgpuScene;
+use crate::wide_query::query_method;
 use crate::WgpuBackend;
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
-use raytrail_core::key::KeyWidth;
-use raytrail_core::method::{Method, Query, WideMethod};
-use raytrail_core::trace::{Record, TraceOptions, TriangleTestKind};
+use raytrail_core::method::WideMethod;
 use raytrail_core::wide::WideTree;
 use raytrail_core::{Error, Hit, Ray};
 
@@ -32,10 +28,6 @@ const FIRST_SLOT_HITS: usize = 8;
 /// (132 bytes a ray at the first slot size).
 const CHUNK_RAYS: usize = 1 << 16;
 
-/// The methods whose trees the core's all-hits walk reads, in the order it prefers them
-/// ([`raytrail_core::prepared::PreparedScene::query_tree`]): the GPU walks the same tree.
-const QUERY_TREES: [WideMethod; 4] = [WideMethod::BVH8_SAH, WideMethod::BVH8, WideMethod::BVH4, WideMethod::BVH4_NAIVE];
-
 impl WgpuBackend {
     /// [`Trace::all_hits`](raytrail_core::trace::Trace::all_hits) on the device.
     pub(crate) fn trace_all_hits(
@@ -45,12 +37,7 @@ impl WgpuBackend {
         options: &AllHitsOptions,
     ) -> Result<AllHits, Error> {
         let prepared = &scene.prepared;
-        // Fails here, with the core's reason, for a scene without a wide tree.
-        prepared.query_tree()?;
-        let method = QUERY_TREES
-            .into_iter()
-            .find(|&m| prepared.wide_root(m).is_ok())
-            .ok_or(Error::NotPrepared { method: "all hits", missing: "a wide tree" })?;
+        let method = query_method(prepared)?;
         let references = match prepared.wide_tree(method)? {
             WideTree::Four(t) => t.triangles().len(),
             WideTree::Eight(t) => t.triangles().len(),
@@ -119,35 +106,12 @@ impl WgpuBackend {
 
     /// Traces `rays` with slots of `slot` hits; returns every ray's slot, in ray order.
     fn trace_lists(&self, scene: &WgpuScene, lists: &Lists, rays: &[Ray], slot: usize) -> Result<Vec<u32>, Error> {
-        let stride = 1 + 4 * slot;
-        let binding = self.gpu.limits.max_storage_buffer_binding_size.min(self.gpu.limits.max_buffer_size);
-        if 4 * stride as u64 > binding {
-            return Err(device_error(format!(
-                "a ray's list of {slot} hits exceeds the device's largest binding ({binding} bytes): ask \
-                 for fewer hits per ray (max_hits)"
-            )));
-        }
-        let variant = Variant {
-            method: Method::Wide(lists.method),
-            keys: KeyWidth::W32,
-            triangle: TriangleTestKind::Watertight,
-            query: Query::Closest,
-            record: Record::Nothing,
-            dispatch: DispatchKind::Grid,
-            workgroup_size: self.config.workgroup_size,
-            all_hits: true,
-        };
-        let pipeline = self.pipelines.get(&self.gpu, &variant)?;
-        let options = TraceOptions::new(lists.method);
-        let config = GpuConfig { dispatch: Dispatch::Grid, ..self.config };
-        let mut launch = launch::launch(scene, &options, slot, &pipeline, &self.pipelines.bind_layout, config)?;
-        launch.params.record_stride = stride as u32;
-        launch.params.record_cap = slot as u32;
-        launch.params.all_hits_keep = lists.keep.min(u32::MAX as usize) as u32;
-        launch.params.all_hits_merge = u32::from(lists.merge);
-        let mut ws = scene.workspace()?;
-        let mut hits = vec![Hit::MISS; rays.len()];
-        Ok(batch::run(&self.gpu, &mut ws, &launch, rays, &mut hits)?.records)
+        let (_, records) = self.run_wide_query(scene, lists.method, Answer::AllHits, rays, 1 + 4 * slot, |p| {
+            p.record_cap = slot.min(u32::MAX as usize) as u32;
+            p.all_hits_keep = lists.keep.min(u32::MAX as usize) as u32;
+            p.all_hits_merge = u32::from(lists.merge);
+        })?;
+        Ok(records)
     }
 }
 

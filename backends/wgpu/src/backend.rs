@@ -12,6 +12,7 @@ use crate::workspace::bytes_moved;
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::bvh2::NodeRef;
 use raytrail_core::method::Method;
+use raytrail_core::nearest::NearestPoint;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::stream::{StreamParams, StreamPlan};
@@ -182,6 +183,16 @@ impl Trace for WgpuBackend {
     /// A hit list per ray on the device (shaders/all_hits.wgsl), on the tree the core's walk reads.
     fn all_hits(&self, scene: &WgpuScene, rays: &[Ray], options: &AllHitsOptions) -> Result<AllHits, Error> {
         self.trace_all_hits(scene, rays, options)
+    }
+
+    /// A query point per invocation (shaders/nearest.wgsl), on the tree the core's walk reads.
+    fn nearest_points(
+        &self,
+        scene: &WgpuScene,
+        points: &[[f32; 3]],
+        radius: f32,
+    ) -> Result<Vec<Option<NearestPoint>>, Error> {
+        self.trace_nearest_points(scene, points, radius)
     }
 }
 

@@ -49,6 +49,7 @@ const KD_RESTART: Part = part!(KD_RESTART);
 const KD_PACKET: Part = part!(KD_PACKET);
 const ENTRY: Part = part!(ENTRY);
 const ALL_HITS: Part = part!(ALL_HITS);
+const NEAREST: Part = part!(NEAREST);
 const DISPATCH_GRID: Part = part!(DISPATCH_GRID);
 const DISPATCH_PERSISTENT: Part = part!(DISPATCH_PERSISTENT);
 const WIDE: Part = part!(WIDE);
@@ -74,9 +75,21 @@ pub struct Variant {
     pub dispatch: DispatchKind,
     /// Invocations per workgroup (the `WORKGROUP_SIZE` override).
     pub workgroup_size: u32,
-    /// Every hit along each ray (`all_hits.wgsl`, a list per ray) instead of `query`'s answer:
-    /// for the wide stack walk's methods only.
-    pub all_hits: bool,
+    /// What the kernel answers: a hit per ray (`query`'s closest or any hit), or a query of the
+    /// scene's wide tree beyond it (for the wide stack walk's methods only).
+    pub answer: Answer,
+}
+
+/// What a kernel answers for each of its work items.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Answer {
+    /// One hit per ray, the closest or any one (`query.wgsl`): every method's kernel.
+    #[default]
+    Hit,
+    /// Every hit along each ray, a list per ray (`all_hits.wgsl`).
+    AllHits,
+    /// The point of the mesh nearest to each query point (`nearest.wgsl`).
+    Nearest,
 }
 
 /// The dispatch file of a kernel: what [`Dispatch`] compiles to (the number of persistent
@@ -105,7 +118,11 @@ impl Variant {
     pub fn label(&self) -> String {
         format!(
             "{}{}/{}/{}/{}/{:?}/{:?}/{}",
-            if self.all_hits { "all-hits/" } else { "" },
+            match self.answer {
+                Answer::Hit => "",
+                Answer::AllHits => "all-hits/",
+                Answer::Nearest => "nearest/",
+            },
             self.method.name(),
             if self.keys == KeyWidth::W64 { "k64" } else { "k32" },
             match self.triangle {
@@ -121,8 +138,8 @@ impl Variant {
 
     /// The WGSL files of this kernel, in order; [`Error::Unsupported`] for a method without one.
     pub fn parts(&self) -> Result<Vec<Part>, Error> {
-        if self.all_hits {
-            return self.all_hits_parts();
+        if self.answer != Answer::Hit {
+            return self.wide_query_parts();
         }
         let mut parts = self.method_parts()?;
         // The stream method's intersection kernel has its own entry point.
@@ -145,22 +162,32 @@ impl Variant {
         Ok(parts)
     }
 
-    /// The all-hits kernel's files: the wide stack walk's, with `all_hits` as the query and the
-    /// work items; [`Error::Unsupported`] for a method of another walk.
-    fn all_hits_parts(&self) -> Result<Vec<Part>, Error> {
+    /// The files of a query of the wide tree beyond a hit per ray: the wide stack walk's, with
+    /// `all_hits` in place of `query` (the answer and the work items), or `nearest` after them (a
+    /// walk of its own), then the dispatch file; [`Error::Unsupported`] for a method of another
+    /// walk.
+    fn wide_query_parts(&self) -> Result<Vec<Part>, Error> {
         if !self.method.wide().is_some_and(|m| m.walk() == WideWalk::Stack) {
-            return Err(Error::Unsupported {
-                method: self.method.name(),
-                by: "the all-hits kernel (wide stack walks)",
-            });
+            let by = "the queries beyond a hit per ray (wide stack walks)";
+            return Err(Error::Unsupported { method: self.method.name(), by });
         }
-        let parts = self.method_parts()?.into_iter().map(|p| if p == QUERY { ALL_HITS } else { p });
-        Ok(parts
-            .chain([match self.dispatch {
-                DispatchKind::Grid => DISPATCH_GRID,
-                DispatchKind::Persistent => DISPATCH_PERSISTENT,
-            }])
-            .collect())
+        let mut parts = self.method_parts()?;
+        match self.answer {
+            Answer::AllHits => {
+                for p in &mut parts {
+                    if *p == QUERY {
+                        *p = ALL_HITS;
+                    }
+                }
+            }
+            Answer::Nearest => parts.push(NEAREST),
+            Answer::Hit => {}
+        }
+        parts.push(match self.dispatch {
+            DispatchKind::Grid => DISPATCH_GRID,
+            DispatchKind::Persistent => DISPATCH_PERSISTENT,
+        });
+        Ok(parts)
     }
 
     /// The files up to and including the method's, without work items or a dispatch file (the
@@ -311,7 +338,7 @@ pub fn all_variants(keys: KeyWidth) -> impl Iterator<Item = Variant> {
                         record,
                         dispatch,
                         workgroup_size: crate::GpuConfig::default().workgroup_size,
-                        all_hits: false,
+                        answer: Answer::Hit,
                     })
                 })
             })
@@ -363,10 +390,16 @@ mod tests {
         assert_eq!(n, 2 * Method::ALL.len() * 2 * 2 * 3 * 2);
     }
 
-    /// The all-hits kernel of every wide stack walk validates under both dispatch files; every
-    /// other method is refused by name.
+    /// The all-hits and nearest-point kernels of every wide stack walk validate under both
+    /// dispatch files; every other method is refused by name.
     #[test]
-    fn all_hits_kernels_validate_for_the_wide_stack_walks_and_only_for_them() {
+    fn query_kernels_validate_for_the_wide_stack_walks_and_only_for_them() {
+        for (answer, file) in [(Answer::AllHits, "shaders/all_hits.wgsl"), (Answer::Nearest, "shaders/nearest.wgsl")] {
+            query_kernels_validate(answer, file);
+        }
+    }
+
+    fn query_kernels_validate(answer: Answer, file: &str) {
         let variant = |method: Method, dispatch| Variant {
             method,
             keys: KeyWidth::W32,
@@ -375,7 +408,7 @@ mod tests {
             record: Record::Nothing,
             dispatch,
             workgroup_size: 64,
-            all_hits: true,
+            answer,
         };
         let mut walks = 0;
         for method in Method::ALL {
@@ -383,7 +416,7 @@ mod tests {
                 let v = variant(method, dispatch);
                 if method.wide().is_some_and(|m| m.walk() == WideWalk::Stack) {
                     validate(&v).unwrap_or_else(|e| panic!("{}:\n{e}", v.label()));
-                    assert!(v.source().unwrap().contains("shaders/all_hits.wgsl"));
+                    assert!(v.source().unwrap().contains(file));
                     walks += 1;
                 } else {
                     assert!(matches!(v.source(), Err(Error::Unsupported { .. })), "{}", v.label());
@@ -406,7 +439,7 @@ mod tests {
                 record: Record::Nothing,
                 dispatch: DispatchKind::Grid,
                 workgroup_size: 64,
-                all_hits: false,
+                answer: Answer::Hit,
             };
             (v.source().expect("a kernel"), v.overrides())
         };

@@ -2,7 +2,7 @@
 //! parameters, and the packet kernels' arrangement of rays into packets.
 
 use crate::batch::Launch;
-use crate::compose::{DispatchKind, Variant};
+use crate::compose::{Answer, DispatchKind, Variant};
 use crate::config::{Dispatch, GpuConfig};
 use crate::params::Params;
 use crate::record;
@@ -31,7 +31,7 @@ pub(crate) fn variant(scene: &WgpuScene, options: &TraceOptions, config: &GpuCon
         record: options.record,
         dispatch: DispatchKind::of(config.dispatch, options.method),
         workgroup_size: config.workgroup_size,
-        all_hits: false,
+        answer: Answer::Hit,
     }
 }
 

@@ -24,6 +24,7 @@ mod device;
 mod float_controls;
 mod kernel;
 mod launch;
+mod nearest;
 mod params;
 mod pipelines;
 mod probe;
@@ -32,6 +33,7 @@ mod scene;
 mod spirv;
 mod stream;
 mod timing;
+mod wide_query;
 mod workspace;
 
 pub use backend::WgpuBackend;

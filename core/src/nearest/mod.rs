@@ -6,7 +6,8 @@
 //!   nearest) in `f32`;
 //! - [`nearest_point_in`] (`walk.rs`): a wide tree walked nearest box first, culling boxes
 //!   farther than the best distance so far; [`nearest_point`] in a prepared scene's frame, and a
-//!   batch ([`nearest_points`]).
+//!   batch ([`nearest_points`]); [`framed_query`], [`query_bound`] and [`unframed`], the steps
+//!   around the walk that a backend with a walk of its own (the GPU's) takes alike.
 //!
 //! Ties (two triangles at one distance, as at a shared edge or vertex) go to the lower primitive
 //! id, as hits do, so the answer does not depend on the tree.
@@ -15,7 +16,7 @@ mod triangle;
 mod walk;
 
 pub use triangle::{closest_point_on_triangle, PointOnTriangle};
-pub use walk::{nearest_point, nearest_point_in, nearest_points};
+pub use walk::{framed_query, nearest_point, nearest_point_in, nearest_points, query_bound, unframed};
 
 /// The point of the mesh nearest to a query point.
 #[derive(Clone, Copy, Debug, PartialEq)]

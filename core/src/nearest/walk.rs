@@ -29,12 +29,9 @@ pub fn nearest_point_in<const W: usize, M: WideMemory<W> + ?Sized>(
     radius: f32,
     stack: &mut Vec<(WideChild, f32)>,
 ) -> Option<NearestPoint> {
-    if !p.is_finite() || radius.is_nan() || radius < 0.0 {
-        return None;
-    }
-    let mut best: Option<NearestPoint> = None;
     // Squared distance a candidate must not exceed: the radius, then the best so far.
-    let mut bound = radius * radius;
+    let mut bound = query_bound(p, radius)?;
+    let mut best: Option<NearestPoint> = None;
     stack.clear();
     stack.push((root.root, 0.0));
     let mut budget = root.max_steps;
@@ -106,19 +103,33 @@ pub fn nearest_point(
     radius: f32,
     stack: &mut Vec<(WideChild, f32)>,
 ) -> Option<NearestPoint> {
-    let k = scene.exponent;
-    let scaled = Vec3::from_array(p.map(|x| scale_pow2(x, -k)));
+    let (scaled, r) = framed_query(scene, p, radius);
     let (tree, root) = tree;
-    let r = scale_pow2(radius, -k);
     let found = match tree {
         WideTree::Four(t) => nearest_point_in::<4, _>(&t.memory(), root, scaled, r, stack),
         WideTree::Eight(t) => nearest_point_in::<8, _>(&t.memory(), root, scaled, r, stack),
     }?;
-    Some(NearestPoint {
-        point: found.point.map(|x| scale_pow2(x, k)),
-        distance: scale_pow2(found.distance, k),
-        ..found
-    })
+    Some(unframed(scene, found))
+}
+
+/// A query point and search radius in `scene`'s frame (the scene's power-of-two scale applied),
+/// as [`nearest_point_in`] takes them: what every backend's walk is handed.
+pub fn framed_query(scene: &PreparedScene, p: [f32; 3], radius: f32) -> (Vec3, f32) {
+    let k = scene.exponent;
+    (Vec3::from_array(p.map(|x| scale_pow2(x, -k))), scale_pow2(radius, -k))
+}
+
+/// The squared distance a point must not exceed for a query in the scene's frame
+/// ([`framed_query`]), as [`nearest_point_in`] starts from it; `None` where that walk answers
+/// `None` before visiting a node (a point that is not finite, a radius that is negative or NaN).
+pub fn query_bound(p: Vec3, radius: f32) -> Option<f32> {
+    (p.is_finite() && !radius.is_nan() && radius >= 0.0).then_some(radius * radius)
+}
+
+/// A nearest point found in `scene`'s frame, with its distance, back in the caller's frame.
+pub fn unframed(scene: &PreparedScene, found: NearestPoint) -> NearestPoint {
+    let k = scene.exponent;
+    NearestPoint { point: found.point.map(|x| scale_pow2(x, k)), distance: scale_pow2(found.distance, k), ..found }
 }
 
 /// [`nearest_point`] of each of `points`, one after another on this thread (a backend splits a

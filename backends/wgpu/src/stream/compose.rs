@@ -5,7 +5,7 @@
 //! triangle test, query, recording and wide.wgsl's leaf test, as the wide methods' kernels do.
 
 use super::shared_parts::{stream_header, Part, INTERSECT_OWN, STREAM_COMMON, STREAM_LEVELS};
-use crate::compose::{constants_header, Variant};
+use crate::compose::{constants_header, Answer, Variant};
 use raytrail_core::key::KeyWidth;
 use raytrail_core::method::{Method, StreamMethod};
 use raytrail_core::trace::{Record, TraceOptions};
@@ -82,7 +82,7 @@ impl StreamKernel {
             // Its own entry point: these two are not used.
             dispatch: Default::default(),
             workgroup_size: crate::GpuConfig::default().workgroup_size,
-            all_hits: false,
+            answer: Answer::Hit,
         })
     }
 
