@@ -2,13 +2,16 @@
 //! against the CPU ray by ray.
 
 use raytrail::core::method::{Method, Query};
+use raytrail::core::nearest::NearestPoint;
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::{Trace, TraceOptions};
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::gpu::{WgpuBackend, WgpuScene};
+use raytrail::{AllHits, AllHitsOptions};
 use raytrail_conformance::check::{check_against, Context, Mismatch};
 use std::sync::Arc;
+use std::time::Instant;
 
 /// Median seconds of a method's GPU passes.
 #[derive(Clone, Copy, Debug)]
@@ -79,5 +82,23 @@ impl Gpu {
         rays: &[Ray],
     ) -> Result<Vec<Mismatch>, String> {
         check_against(cpu, cpu_scene, &self.backend, &self.scene, ctx, rays, &Method::ALL).map_err(|e| e.to_string())
+    }
+
+    /// Every hit along each of `rays` on the GPU, after an untimed call that compiles the kernel;
+    /// with the timed call's seconds.
+    pub fn all_hits(&self, rays: &[Ray], options: &AllHitsOptions) -> Result<(AllHits, f64), String> {
+        self.backend.all_hits(&self.scene, &rays[..rays.len().min(1)], options).map_err(|e| e.to_string())?;
+        let start = Instant::now();
+        let lists = self.backend.all_hits(&self.scene, rays, options).map_err(|e| e.to_string())?;
+        Ok((lists, start.elapsed().as_secs_f64()))
+    }
+
+    /// The nearest point to each of `points` on the GPU, after an untimed call that compiles the
+    /// kernel; with the timed call's seconds.
+    pub fn nearest_points(&self, points: &[[f32; 3]], radius: f32) -> Result<(Vec<Option<NearestPoint>>, f64), String> {
+        self.backend.nearest_points(&self.scene, &points[..points.len().min(1)], radius).map_err(|e| e.to_string())?;
+        let start = Instant::now();
+        let found = self.backend.nearest_points(&self.scene, points, radius).map_err(|e| e.to_string())?;
+        Ok((found, start.elapsed().as_secs_f64()))
     }
 }

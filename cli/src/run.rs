@@ -150,7 +150,7 @@ pub fn main(a: RunArgs) -> Outcome {
     print_kd(&per_set);
     print_stream(&tables);
     let camera = sets.first().map_or(&[][..], |s| s.rays.as_slice());
-    let query_failures = crate::queries::print_queries(&backend, &prepared, scene, builder, camera)?;
+    let query_failures = crate::queries::print_queries(&backend, gpu.as_ref(), &prepared, scene, builder, camera)?;
     let refused: Vec<String> = tables
         .iter()
         .filter(|t| t.refused > 0)

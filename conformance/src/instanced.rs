@@ -176,6 +176,28 @@ pub fn instanced_mismatches<B: Trace>(backend: &B, case: &InstancedCase, truth: 
     out
 }
 
+/// Every closest hit of `hits` (of `rays` through `instances`) that disagrees with the exact
+/// answer of the flattened triangles (`flat` and `first` from [`flatten`]) beyond the edge
+/// tolerance of [`judge`]: a line per wrong ray.
+pub fn closest_disagreements(
+    flat: &[Triangle],
+    first: &[u32],
+    instances: &[Instance],
+    rays: &[Ray],
+    hits: &[InstanceHit],
+) -> Vec<String> {
+    let exact = ExactScene::new(flat.to_vec());
+    let tol = Tolerance::for_scene(Scene::new(flat.to_vec()).map_or(f32::INFINITY, |s| s.bounds().max_abs()));
+    let mut out = Vec::new();
+    for (i, (ray, h)) in rays.iter().zip(hits).enumerate() {
+        let flat_hit = to_flat(h, first, instances);
+        if let Judgement::Disagree(why) = judge(ray, flat, &exact.closest_hit(ray), &flat_hit, tol, false) {
+            out.push(format!("ray {i} {ray:?}: {why} (got {h:?})"));
+        }
+    }
+    out
+}
+
 /// An instanced answer as a hit on the flattened triangles (`first` from [`flatten`]), checking
 /// that it names the instance's own id.
 fn to_flat(h: &InstanceHit, first: &[u32], instances: &[Instance]) -> Hit {

@@ -1,9 +1,13 @@
 //! The instanced check fails on planted faults: a placement traced where its flattened triangles
 //! are not, and a bad instance refused when the scene is made.
 
-use raytrail_conformance::instanced::{instanced_case, instanced_mismatches};
+use raytrail_conformance::instanced::{closest_disagreements, flatten, instanced_case, instanced_mismatches};
+use raytrail_conformance::rays::primary;
 use raytrail_conformance::SerialBackend;
-use raytrail_core::instance::{Instance, InstancedScene, Transform};
+use raytrail_core::instance::{trace_instanced, Instance, InstanceHit, InstancedScene, Transform};
+use raytrail_core::method::{Bvh2Method, Method};
+use raytrail_core::scene::Scene;
+use raytrail_core::trace::TraceOptions;
 use raytrail_core::Error;
 
 #[test]
@@ -22,6 +26,25 @@ fn a_wrong_transform_is_caught() {
     truth[2].transform = moved;
     let wrong = instanced_mismatches(&SerialBackend, &case, &truth);
     assert!(wrong.len() > 10, "a moved instance went unnoticed: {wrong:?}");
+}
+
+/// The main job's judgement of closest hits alone (`closest_disagreements`) passes on the true
+/// placements and catches the moved one.
+#[test]
+fn the_closest_hit_judgement_catches_a_wrong_transform() {
+    let case = instanced_case();
+    let scene = InstancedScene::prepare(&SerialBackend, &case.meshes, &case.instances).expect("prepare");
+    let (flat, first) = flatten(&case.scenes, &case.instances, None);
+    let rays = primary(&Scene::new(flat.clone()).expect("a flat scene"), 32, 24);
+    let mut hits = vec![InstanceHit::MISS; rays.len()];
+    let opts = TraceOptions::new(Method::Bvh2(Bvh2Method::Stack));
+    trace_instanced(&SerialBackend, &scene, &rays, None, &opts, &mut hits).expect("trace");
+    assert_eq!(closest_disagreements(&flat, &first, &case.instances, &rays, &hits), Vec::<String>::new());
+    let mut truth = case.instances.clone();
+    truth[2].transform = Transform::translation([0.05, 0.0, 0.0]).then_after(&truth[2].transform);
+    let (moved, first) = flatten(&case.scenes, &truth, None);
+    let wrong = closest_disagreements(&moved, &first, &case.instances, &rays, &hits);
+    assert!(wrong.len() > 5, "a moved instance went unnoticed: {wrong:?}");
 }
 
 #[test]
