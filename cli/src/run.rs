@@ -175,7 +175,7 @@ pub fn main(a: RunArgs) -> Outcome {
         }
     }
     if query_failures > 0 {
-        outln!("\nQUERY CHECKS FAILED: {query_failures} lists, points or refit hits differ (see the queries table)");
+        outln!("\nQUERY CHECKS FAILED: {query_failures} lists, points, instanced hits or refit hits differ (see the queries table)");
     }
     Ok(if failures.is_empty() && query_failures == 0 { 0 } else { 1 })
 }
