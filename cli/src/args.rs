@@ -9,6 +9,7 @@ use raytrail::mesh::{write_sources_csv, LoadOptions, LoadReport};
 use raytrail::Builder;
 use raytrail_cli::write::same_file;
 use raytrail_conformance::NamedScene;
+use std::ffi::{OsStr, OsString};
 use std::path::{Path, PathBuf};
 
 const AFTER_HELP: &str = "\
@@ -147,8 +148,8 @@ pub const TRIANGLE_TESTS: [&str; 2] = ["watertight", "moller-trumbore"];
 #[derive(clap::Args, Debug, Clone)]
 pub struct AccuracyArgs {
     /// Scene files (or `builtin`), comma-separated
-    #[arg(long, short = 's', value_name = "FILE[,FILE...]", value_delimiter = ',', default_value = BUILTIN_SCENE)]
-    pub scene: Vec<String>,
+    #[arg(long, short = 's', value_name = "FILE[,FILE...]", default_value = BUILTIN_SCENE)]
+    pub scene: OsString,
     /// Ray types, comma-separated: primary, shadow, soft-shadow, diffuse, ao
     #[arg(long, value_name = "TYPE[,TYPE...]", value_delimiter = ',', default_value = "primary,shadow,diffuse,ao")]
     pub rays: Vec<String>,
@@ -182,10 +183,10 @@ pub struct AccuracyArgs {
     pub builder: String,
     /// Also write the results as JSON
     #[arg(long, value_name = "FILE")]
-    pub json: Option<String>,
+    pub json: Option<PathBuf>,
     /// Also write an SVG plot of Mrays/s against error rate, the Pareto front marked
     #[arg(long, value_name = "FILE.svg")]
-    pub plot: Option<String>,
+    pub plot: Option<PathBuf>,
     /// Most rays per ray set
     #[arg(long, value_name = "N", default_value_t = crate::limits::DEFAULT_MAX_RAYS)]
     pub max_rays: u64,
@@ -439,6 +440,25 @@ pub fn ploc_note(builder: Builder, scene: &raytrail::core::scene::Scene) {
 }
 
 /// Whether `path` names the built-in scene rather than a file.
+/// A comma-separated list of paths as the system gave it (on Unix, bytes that are not UTF-8
+/// kept): split at each comma, each trimmed of ASCII white space, empty ones left out.
+pub fn path_list(list: &OsStr) -> Vec<PathBuf> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        list.as_bytes()
+            .split(|&b| b == b',')
+            .map(<[u8]>::trim_ascii)
+            .filter(|p| !p.is_empty())
+            .map(|p| PathBuf::from(OsStr::from_bytes(p)))
+            .collect()
+    }
+    #[cfg(not(unix))]
+    {
+        list.to_string_lossy().split(',').map(str::trim).filter(|p| !p.is_empty()).map(PathBuf::from).collect()
+    }
+}
+
 pub fn is_builtin(path: &Path) -> bool {
     path.as_os_str() == BUILTIN_SCENE
 }

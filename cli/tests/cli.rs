@@ -293,4 +293,32 @@ fn paths_are_taken_as_the_system_has_them_not_only_as_utf8() {
     let out =
         bin().args(["trace", "--scene"]).arg(&scene).arg("--rays").arg(&rays).arg("--out").arg(&rays).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    // The commands that take comma-separated lists of scenes keep each path's bytes too, and so
+    // do their JSON outputs.
+    let mut list = std::ffi::OsString::from("builtin, ");
+    list.push(&scene);
+    let (bench_json, accuracy_json) = (named(b"bench\xfb.json"), named(b"accuracy\xfa.json"));
+    let tiny = ["-W", "16", "-H", "12", "--passes", "1", "--rays", "primary", "--methods", "stack"];
+    ok(bin()
+        .args(["bench", "--peers", "none", "--no-gpu", "--view", "outside"])
+        .args(tiny)
+        .arg("--scene")
+        .arg(&list)
+        .arg("--json")
+        .arg(&bench_json)
+        .output()
+        .unwrap());
+    ok(bin()
+        .args(["accuracy", "--sample", "8"])
+        .args(tiny)
+        .arg("--scene")
+        .arg(&list)
+        .arg("--json")
+        .arg(&accuracy_json)
+        .output()
+        .unwrap());
+    for json in [&bench_json, &accuracy_json] {
+        let text = std::fs::read_to_string(json).unwrap();
+        assert!(text.contains("tea\u{fffd}pot"), "both scenes reported: {text:.300}");
+    }
 }

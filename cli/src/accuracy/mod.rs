@@ -48,7 +48,7 @@ const EXACT_CHUNK: usize = 512;
 
 /// The checked flags.
 struct Plan {
-    scenes: Vec<String>,
+    scenes: Vec<std::path::PathBuf>,
     kinds: Vec<RayKind>,
     methods: Vec<Method>,
     tests: Vec<TriangleTestKind>,
@@ -112,7 +112,8 @@ fn plan(a: &AccuracyArgs) -> Result<Plan, Failure> {
             tests.push(t);
         }
     }
-    if kinds.is_empty() || methods.is_empty() || tests.is_empty() || a.scene.is_empty() {
+    let scenes = crate::args::path_list(&a.scene);
+    if kinds.is_empty() || methods.is_empty() || tests.is_empty() || scenes.is_empty() {
         return Err(usage("--scene, --rays, --methods and --tests each need at least one value".to_string()));
     }
     let (views, auto_view) = match a.view.as_str() {
@@ -122,7 +123,7 @@ fn plan(a: &AccuracyArgs) -> Result<Plan, Failure> {
         _ => (vec![View::Outside, View::Inside], true),
     };
     Ok(Plan {
-        scenes: a.scene.iter().map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect(),
+        scenes,
         kinds,
         methods,
         tests,
@@ -144,16 +145,16 @@ pub fn main(a: AccuracyArgs, args: &[String]) -> Outcome {
     let p = plan(&a)?;
     for (flag, path) in [("json", &a.json), ("plot", &a.plot)] {
         if let Some(path) = path {
-            check_output(flag, Path::new(path))?;
+            check_output(flag, path)?;
         }
     }
     for path in &p.scenes {
-        check_input("scene", Path::new(path))?;
+        check_input("scene", path)?;
     }
-    let inputs: Vec<_> = p.scenes.iter().map(|s| ("scene", Path::new(s))).collect();
+    let inputs: Vec<_> = p.scenes.iter().map(|s| ("scene", s.as_path())).collect();
     let outputs: Vec<_> = [("json", &a.json), ("plot", &a.plot)]
         .into_iter()
-        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, Path::new(p))))
+        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, p)))
         .collect();
     check_distinct(&inputs, &outputs)?;
     let pixels = u64::from(p.width) * u64::from(p.height);
@@ -182,15 +183,16 @@ pub fn main(a: AccuracyArgs, args: &[String]) -> Outcome {
         scenes,
     };
     if let Some(path) = &a.json {
-        let text = serde_json::to_string_pretty(&report).map_err(|e| format!("cannot write {path}: {e}"))?;
+        let cannot = |e: &dyn std::fmt::Display| format!("cannot write {}: {e}", path.display());
+        let text = serde_json::to_string_pretty(&report).map_err(|e| cannot(&e))?;
         write_atomically(path, |w| w.write_all(text.as_bytes()).and_then(|_| w.write_all(b"\n")))
-            .map_err(|e| format!("cannot write {path}: {e}"))?;
-        errln!("wrote {path}");
+            .map_err(|e| cannot(&e))?;
+        errln!("wrote {}", path.display());
     }
     if let Some(path) = &a.plot {
         write_atomically(path, |w| w.write_all(plot::to_svg(&report).as_bytes()))
-            .map_err(|e| format!("cannot write {path}: {e}"))?;
-        errln!("wrote {path}");
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        errln!("wrote {}", path.display());
     }
     let defaults_wrong: usize = report
         .scenes
@@ -219,8 +221,8 @@ pub fn sample_indices(len: usize, n: usize) -> Vec<usize> {
 }
 
 /// Loads and prepares one scene, and measures every view of it that is kept.
-fn measure_scene(path: &str, p: &Plan) -> Result<Vec<SceneReport>, String> {
-    let (loaded, _) = timed(&format!("loading {path}"), || crate::args::load_scene(Path::new(path), &p.load));
+fn measure_scene(path: &Path, p: &Plan) -> Result<Vec<SceneReport>, String> {
+    let (loaded, _) = timed(&format!("loading {}", path.display()), || crate::args::load_scene(path, &p.load));
     let (named, _, warning) = loaded?;
     crate::args::warn(&warning);
     let scene = &named.scene;

@@ -51,18 +51,18 @@ pub fn main(a: options::BenchArgs, args: &[String]) -> Outcome {
     let opts = Options::from_args(&a).map_err(Failure::Usage)?;
     check_baseline(&opts).map_err(Failure::Usage)?;
     if let Some(path) = &opts.json {
-        check_output("json", Path::new(path))?;
+        check_output("json", path)?;
     }
     if let Some(path) = &opts.plot {
-        check_output("plot", Path::new(path))?;
+        check_output("plot", path)?;
     }
     for path in &opts.scenes {
-        check_input("scene", Path::new(path))?;
+        check_input("scene", path)?;
     }
-    let inputs: Vec<_> = opts.scenes.iter().map(|s| ("scene", Path::new(s))).collect();
+    let inputs: Vec<_> = opts.scenes.iter().map(|s| ("scene", s.as_path())).collect();
     let outputs: Vec<_> = [("json", &opts.json), ("plot", &opts.plot)]
         .into_iter()
-        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, Path::new(p))))
+        .filter_map(|(flag, path)| path.as_deref().map(|p| (flag, p)))
         .collect();
     check_distinct(&inputs, &outputs)?;
     let pools = opts
@@ -93,13 +93,13 @@ pub fn main(a: options::BenchArgs, args: &[String]) -> Outcome {
     };
     if let Some(path) = &opts.json {
         write_atomically(path, |w| w.write_all(json::to_json(&report).as_bytes()))
-            .map_err(|e| format!("cannot write {path}: {e}"))?;
-        errln!("wrote {path}");
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        errln!("wrote {}", path.display());
     }
     if let Some(path) = &opts.plot {
         write_atomically(path, |w| w.write_all(plot::to_svg(&report).as_bytes()))
-            .map_err(|e| format!("cannot write {path}: {e}"))?;
-        errln!("wrote {path}");
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        errln!("wrote {}", path.display());
     }
     Ok(0)
 }
@@ -132,13 +132,13 @@ fn check_baseline(opts: &Options) -> Result<(), String> {
 /// scene; one report per view, in order, each also handed to `done` as soon as it is measured. The
 /// trees are built once and serve every view.
 fn bench_scene(
-    path: &str,
+    path: &Path,
     opts: &Options,
     pools: &[(usize, rayon::ThreadPool)],
     done: &mut dyn FnMut(&SceneReport),
 ) -> Result<Vec<SceneReport>, String> {
     let options = LoadOptions { strict: opts.strict, ..LoadOptions::default() };
-    let (loaded, _) = timed(&format!("loading {path}"), || crate::args::load_scene(Path::new(path), &options));
+    let (loaded, _) = timed(&format!("loading {}", path.display()), || crate::args::load_scene(path, &options));
     let (named, _, warning) = loaded?;
     crate::args::warn(&warning);
     let scene = &named.scene;
@@ -369,7 +369,7 @@ mod tests {
         let opts = Options::parse(&args).unwrap();
         let pools = vec![(1, rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap())];
         let mut printed = Vec::new();
-        let views = bench_scene("builtin", &opts, &pools, &mut |s| printed.push(s.name.clone())).unwrap();
+        let views = bench_scene(Path::new("builtin"), &opts, &pools, &mut |s| printed.push(s.name.clone())).unwrap();
         assert_eq!(views.iter().map(|s| s.view).collect::<Vec<_>>(), [View::Outside, View::Inside]);
         assert_eq!(printed, views.iter().map(|s| s.name.clone()).collect::<Vec<_>>());
         assert!(views[1].name.ends_with(" (inside)") && !views[0].name.contains("inside"));
@@ -396,12 +396,12 @@ mod tests {
                 }
             }
         }
-        assert!(bench_scene("no/such/scene.obj", &opts, &pools, &mut |_| {}).is_err());
+        assert!(bench_scene(Path::new("no/such/scene.obj"), &opts, &pools, &mut |_| {}).is_err());
         // From inside, the sphereflake's eye is within its big sphere: no room, so `auto` (the
         // default) measures the outside view only.
         let args: Vec<String> = args.iter().take_while(|a| *a != "--view").cloned().collect();
         let opts = Options::parse(&args).unwrap();
-        let views = bench_scene("builtin", &opts, &pools, &mut |_| {}).unwrap();
+        let views = bench_scene(Path::new("builtin"), &opts, &pools, &mut |_| {}).unwrap();
         assert_eq!(views.iter().map(|s| s.view).collect::<Vec<_>>(), [View::Outside]);
     }
 

@@ -10,6 +10,8 @@ use raytrail::core::method::Method;
 use raytrail::core::stream::{StreamParams, MAX_PACKET};
 use raytrail::gpu::{Dispatch, GpuConfig};
 use raytrail::Builder;
+use std::ffi::OsString;
+use std::path::PathBuf;
 
 /// Default primary image: 512 x 512 = 262,144 rays (shadow, diffuse and ambient-occlusion rays
 /// follow from the primary hits). With the three scenes of BENCHMARKS.md (Sponza, the kitchen, the
@@ -35,7 +37,7 @@ pub const PEERS: &[&str] = &["obvhs-bvh2", "obvhs-cwbvh", "bvh", "embree", "embr
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// Scene files (or `builtin`), in order.
-    pub scenes: Vec<String>,
+    pub scenes: Vec<PathBuf>,
     /// Ray types, in order.
     pub rays: Vec<RayKind>,
     /// Primary image width.
@@ -55,9 +57,9 @@ pub struct Options {
     /// Target whose speed the ratio column divides by.
     pub baseline: String,
     /// Where to write JSON, if anywhere.
-    pub json: Option<String>,
+    pub json: Option<PathBuf>,
     /// Where to write the SVG plot, if anywhere.
-    pub plot: Option<String>,
+    pub plot: Option<PathBuf>,
     /// Builder of raytrail's canonical tree.
     pub builder: Builder,
     /// Ambient-occlusion rays per primary hit.
@@ -84,7 +86,7 @@ pub struct Options {
 pub struct BenchArgs {
     /// Scene files (or `builtin`), comma-separated
     #[arg(long, short = 's', value_name = "FILE[,FILE...]", default_value = BUILTIN_SCENE)]
-    pub scene: String,
+    pub scene: OsString,
     /// Ray types, comma-separated: primary, shadow, soft-shadow, diffuse, ao [default: all]
     #[arg(long, value_name = "TYPE[,TYPE...]")]
     pub rays: Option<String>,
@@ -113,10 +115,10 @@ pub struct BenchArgs {
     pub baseline: Option<String>,
     /// Also write the results as JSON
     #[arg(long, value_name = "FILE")]
-    pub json: Option<String>,
+    pub json: Option<PathBuf>,
     /// Also write an SVG plot of the results
     #[arg(long, value_name = "FILE.svg")]
-    pub plot: Option<String>,
+    pub plot: Option<PathBuf>,
     /// BVH2 builder of raytrail's tree: `best` builds with `sbvh` and `ploc` and keeps the lower SAH cost
     #[arg(long, default_value = "best", value_parser = BUILDERS)]
     pub builder: String,
@@ -167,7 +169,7 @@ impl Options {
 
     /// Checks the flags of `raytrail bench`; an error is a usage error.
     pub fn from_args(a: &BenchArgs) -> Result<Options, String> {
-        let scenes = list(&a.scene);
+        let scenes = crate::args::path_list(&a.scene);
         if scenes.is_empty() {
             return Err("--scene: no scene given".to_string());
         }
@@ -413,7 +415,7 @@ mod tests {
     #[test]
     fn defaults_and_lists() {
         let o = parse("").unwrap();
-        assert_eq!(o.scenes, vec!["builtin"]);
+        assert_eq!(o.scenes, vec![PathBuf::from("builtin")]);
         assert_eq!(o.rays, RayKind::ALL.to_vec());
         assert_eq!(o.methods, Method::ALL.to_vec());
         assert_eq!(o.baseline, "obvhs-bvh2");
@@ -426,7 +428,7 @@ mod tests {
         let e = parse("--scene a.obj --colour red").unwrap_err();
         assert!(e.contains("unexpected argument '--colour'"), "{e}");
         let o = parse("--scene a.obj,,b.ply --rays ao,primary,ao --threads 2,1,2 --methods hash,stack").unwrap();
-        assert_eq!(o.scenes, vec!["a.obj", "b.ply"]);
+        assert_eq!(o.scenes, vec![PathBuf::from("a.obj"), PathBuf::from("b.ply")]);
         assert_eq!(o.rays, vec![RayKind::Ao, RayKind::Primary]);
         assert_eq!(o.threads, vec![1, 2]);
         assert_eq!(o.methods, vec![Bvh2Method::Hash.into(), Bvh2Method::Stack.into()]);
