@@ -4,7 +4,8 @@
 # shares its core with other work, or is stopped for a while, still gets its full budget). On
 # stable Rust through RUSTC_BOOTSTRAP=1 and without a sanitizer (a machine with a nightly toolchain
 # may drop both). New inputs go to fuzz/target/campaign/TARGET, beside the committed seeds of
-# fuzz/corpus/TARGET, which stay as they are; a crash input is left in fuzz/artifacts/TARGET/.
+# fuzz/corpus/TARGET, which stay as they are; a crash input is left in the artifacts folder this
+# script has libFuzzer write under fuzz/, in a folder named after the target.
 # Prints one line a target: runs, CPU seconds, wall seconds and how it ended.
 #
 #   scripts/fuzz-campaign.sh [SECONDS] [TARGET...]
