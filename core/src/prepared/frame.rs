@@ -97,6 +97,7 @@ impl FramedRays<'_> {
     /// Puts one hit of ray `i` back in the caller's frame, as [`FramedRays::finish`] does for a
     /// batch's hits (a query that finds several hits per ray puts back each); returns whether
     /// the ray was refused (the hit is then [`Hit::REFUSED`]).
+    #[inline]
     pub fn finish_ray(&self, i: usize, hit: &mut Hit) -> bool {
         match self.fixes.get(i).copied().unwrap_or(Fix::Keep) {
             Fix::Keep => {}
