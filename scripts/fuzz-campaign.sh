@@ -36,6 +36,10 @@ for t in "${targets[@]}"; do
   mkdir -p "$work" "artifacts/$t"
   log=target/campaign/$t.log
   start=$(date +%s)
+  # Crash inputs of earlier campaigns stay in the artifacts folder: only those newer than this
+  # marker are this run's.
+  marker=$work.started
+  touch "$marker"
   "$bin" -print_final_stats=1 -artifact_prefix="artifacts/$t/" "$work" "corpus/$t" >"$log" 2>&1 &
   pid=$!
   used=0
@@ -53,7 +57,7 @@ for t in "${targets[@]}"; do
   ended="exit $status"
   if [ "$status" = 72 ] && [ "$used" -ge "$seconds" ]; then ended="stopped at the budget"; fi
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
-  crashed=$(ls "artifacts/$t" | head -1)
+  crashed=$(find "artifacts/$t" -type f -newer "$marker" -printf '%f\n' | head -1)
   echo "$t: ${runs:-?} runs, ${used} CPU s, $(($(date +%s) - start)) wall s, ${ended}${crashed:+, crash input artifacts/$t/$crashed}"
   if [ -n "$crashed" ]; then tail -30 "$log"; fi
 done

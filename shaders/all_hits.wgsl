@@ -8,8 +8,9 @@
 // CPU's: the nearest hits of the same set under the same total order, whatever the visiting
 // order.
 //
-// A ray's slot (`P.record_stride` words): [0] hits held, then up to `P.record_cap` hits of four
-// words (t, prim, u, v). A list that fills a slot smaller than the keep may have lost hits; the
+// A ray's slot (`P.record_stride` words): [0] hits held (its top bit set where the walk ran out of
+// steps, which only a broken tree makes it do: the list then says it is cut, as the CPU's does),
+// then up to `P.record_cap` hits of four words (t, prim, u, v). A list that fills a slot smaller than the keep may have lost hits; the
 // host traces such rays again with a larger slot (backends/wgpu/src/all_hits.rs).
 
 // The closest-hit answer wide_stack.wgsl's `trace` returns; this kernel's entry does not call it.
@@ -107,11 +108,30 @@ fn item_count() -> u32 {
     return P.ray_count;
 }
 
+// `WideState::run` from the root, as wide_stack.wgsl's `wide_run`; false where the step budget
+// ran out with the walk unfinished.
+fn ah_run() -> bool {
+    WS_CURRENT = wide_root();
+    WS_HAS_CURRENT = true;
+    WS_LEN = 0u;
+    var budget = P.max_steps;
+    loop {
+        if wide_step() == STEP_DONE {
+            return true;
+        }
+        if budget == 0u {
+            return false;
+        }
+        budget = budget - 1u;
+    }
+    return true;
+}
+
 fn run_item(i: u32) {
     AH_BASE = i * P.record_stride;
     AH_KEEP = min(P.all_hits_keep, P.record_cap);
-    if begin(rays[i]) {
-        wide_run(wide_root());
+    if begin(rays[i]) && !ah_run() {
+        records[AH_BASE] = records[AH_BASE] | 0x80000000u;
     }
     hits[i] = miss();
 }

@@ -147,9 +147,9 @@ pub const TRIANGLE_TESTS: [&str; 2] = ["watertight", "moller-trumbore"];
 /// `raytrail accuracy`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct AccuracyArgs {
-    /// Scene files (or `builtin`), comma-separated
-    #[arg(long, short = 's', value_name = "FILE[,FILE...]", default_value = BUILTIN_SCENE)]
-    pub scene: OsString,
+    /// Scene files (or `builtin`), comma-separated (the flag may also be repeated)
+    #[arg(long, short = 's', value_name = "FILE[,FILE...]", default_value = BUILTIN_SCENE, action = clap::ArgAction::Append)]
+    pub scene: Vec<OsString>,
     /// Ray types, comma-separated: primary, shadow, soft-shadow, diffuse, ao
     #[arg(long, value_name = "TYPE[,TYPE...]", value_delimiter = ',', default_value = "primary,shadow,diffuse,ao")]
     pub rays: Vec<String>,
@@ -439,7 +439,6 @@ pub fn ploc_note(builder: Builder, scene: &raytrail::core::scene::Scene) {
     }
 }
 
-/// Whether `path` names the built-in scene rather than a file.
 /// A comma-separated list of paths as the system gave it (on Unix, bytes that are not UTF-8
 /// kept): split at each comma, each trimmed of ASCII white space, empty ones left out.
 pub fn path_list(list: &OsStr) -> Vec<PathBuf> {
@@ -459,6 +458,7 @@ pub fn path_list(list: &OsStr) -> Vec<PathBuf> {
     }
 }
 
+/// Whether `path` names the built-in scene rather than a file.
 pub fn is_builtin(path: &Path) -> bool {
     path.as_os_str() == BUILTIN_SCENE
 }

@@ -308,11 +308,11 @@ fn paths_are_taken_as_the_system_has_them_not_only_as_utf8() {
         .arg(&bench_json)
         .output()
         .unwrap());
+    // `accuracy --scene` may also be given once per scene.
     ok(bin()
-        .args(["accuracy", "--sample", "8"])
+        .args(["accuracy", "--sample", "8", "--scene", "builtin", "--scene"])
+        .arg(&scene)
         .args(tiny)
-        .arg("--scene")
-        .arg(&list)
         .arg("--json")
         .arg(&accuracy_json)
         .output()

@@ -28,6 +28,10 @@ const FIRST_SLOT_HITS: usize = 8;
 /// (132 bytes a ray at the first slot size).
 const CHUNK_RAYS: usize = 1 << 16;
 
+/// The top bit of a slot's first word: the ray's walk ran out of steps (shaders/all_hits.wgsl);
+/// the other bits count the hits held.
+const UNFINISHED_BIT: u32 = 1 << 31;
+
 impl WgpuBackend {
     /// [`Trace::all_hits`](raytrail_core::trace::Trace::all_hits) on the device.
     pub(crate) fn trace_all_hits(
@@ -49,13 +53,14 @@ impl WgpuBackend {
         let mut out = AllHits::default();
         for (c, chunk) in framed.rays().chunks(CHUNK_RAYS).enumerate() {
             let base = c * CHUNK_RAYS;
-            for (k, mut list) in self.lists(scene, &lists, chunk)?.into_iter().enumerate() {
+            for (k, (mut list, unfinished)) in self.lists(scene, &lists, chunk)?.into_iter().enumerate() {
                 let mut probe = Hit::MISS;
                 if framed.finish_ray(base + k, &mut probe) {
                     out.push(&[Hit::REFUSED], false);
                     continue;
                 }
-                let truncated = list.len() > options.max_hits;
+                // A walk the step budget ended (a broken tree) says its list is cut, as the CPU's.
+                let truncated = unfinished || list.len() > options.max_hits;
                 list.truncate(options.max_hits);
                 for hit in &mut list {
                     framed.finish_ray(base + k, hit);
@@ -66,9 +71,10 @@ impl WgpuBackend {
         Ok(out)
     }
 
-    /// The lists of `rays` (in the scene's frame), each of up to `lists.keep` hits, in order.
-    fn lists(&self, scene: &WgpuScene, lists: &Lists, rays: &[Ray]) -> Result<Vec<Vec<Hit>>, Error> {
-        let mut out = vec![Vec::new(); rays.len()];
+    /// The lists of `rays` (in the scene's frame), each of up to `lists.keep` hits, in order, and
+    /// whether each ray's walk ran out of steps.
+    fn lists(&self, scene: &WgpuScene, lists: &Lists, rays: &[Ray]) -> Result<Vec<(Vec<Hit>, bool)>, Error> {
+        let mut out = vec![(Vec::new(), false); rays.len()];
         let mut todo: Vec<usize> = (0..rays.len()).collect();
         let mut slot = FIRST_SLOT_HITS.min(lists.largest_slot);
         loop {
@@ -78,7 +84,7 @@ impl WgpuBackend {
             let mut again = Vec::new();
             for (k, &i) in todo.iter().enumerate() {
                 let words = &records[k * stride..(k + 1) * stride];
-                let held = words[0] as usize;
+                let (held, unfinished) = ((words[0] & !UNFINISHED_BIT) as usize, words[0] & UNFINISHED_BIT != 0);
                 if held > slot {
                     return Err(device_error(format!("ray {i}'s hit list holds {held} hits in a slot of {slot}")));
                 }
@@ -86,7 +92,7 @@ impl WgpuBackend {
                     again.push(i);
                     continue;
                 }
-                out[i] = words[1..1 + 4 * held]
+                let found = words[1..1 + 4 * held]
                     .chunks_exact(4)
                     .map(|w| Hit {
                         t: f32::from_bits(w[0]),
@@ -95,6 +101,7 @@ impl WgpuBackend {
                         v: f32::from_bits(w[3]),
                     })
                     .collect();
+                out[i] = (found, unfinished);
             }
             if again.is_empty() {
                 return Ok(out);

@@ -112,7 +112,7 @@ fn plan(a: &AccuracyArgs) -> Result<Plan, Failure> {
             tests.push(t);
         }
     }
-    let scenes = crate::args::path_list(&a.scene);
+    let scenes: Vec<_> = a.scene.iter().flat_map(|list| crate::args::path_list(list)).collect();
     if kinds.is_empty() || methods.is_empty() || tests.is_empty() || scenes.is_empty() {
         return Err(usage("--scene, --rays, --methods and --tests each need at least one value".to_string()));
     }
