@@ -127,6 +127,14 @@ fn exact_scale(x: f32, k: i32) -> Option<f32> {
 const MODERATE_MIN: f32 = 1.0 / MODERATE_MAX;
 const MODERATE_MAX: f32 = 18_446_744_073_709_551_616.0;
 
+/// Whether a component of direction `d` is so small that its reciprocal overflows (`1 / d` is
+/// infinite for `|d| < 1 / f32::MAX`, a subnormal): the slab test then puts a plane just off the
+/// origin at `t = inf` where the exact crossing is finite, and culls a box the ray enters (a
+/// fuzzed ray along `(5e-40, 8e-40, -0.25)` missed a triangle whose box began at `x = 2.7e-44`).
+fn reciprocal_overflows(d: &[f32; 3]) -> bool {
+    d.iter().any(|&x| x != 0.0 && (1.0 / x).is_infinite())
+}
+
 /// `ray` scaled by `2^-k` and the exponent `e` a hit's `t` must be scaled back by, or `None`
 /// where no exact scaling exists. Origin and direction scale alike where they can and the
 /// direction stays moderate (`e = 0`); where it would overflow, underflow or leave
@@ -135,9 +143,14 @@ const MODERATE_MAX: f32 = 18_446_744_073_709_551_616.0;
 /// scene (`k = 0`) only a direction above [`MODERATE_MAX`] is scaled so: its distances are so
 /// small that the triangle test's products of edge functions and depths underflow (a fuzzed
 /// direction of `1.3e36` hit triangles behind its origin at `t = 0`). Directions below the range
-/// stay as given there, and the reliability bound refuses those it must.
+/// stay as given there, and the reliability bound refuses those it must; but a moderate
+/// direction with a component whose reciprocal overflows ([`reciprocal_overflows`]) is scaled up
+/// until its smallest nonzero component is normal, and refused where that would take its largest
+/// past [`MODERATE_MAX`] or its interval cannot follow exactly (so is one scaled with a scene).
 fn scaled(ray: &Ray, k: i32) -> Option<(Ray, i32)> {
-    if k == 0 && ray.dir.iter().all(|d| d.abs() <= MODERATE_MAX) {
+    let largest = ray.dir.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+    let mixed = largest >= MODERATE_MIN && reciprocal_overflows(&ray.dir);
+    if k == 0 && largest <= MODERATE_MAX && !mixed {
         return Some((*ray, 0));
     }
     let s = |v: [f32; 3], k: i32| -> Option<[f32; 3]> {
@@ -147,12 +160,18 @@ fn scaled(ray: &Ray, k: i32) -> Option<(Ray, i32)> {
     // Alike only where the direction keeps a moderate size: scaled by 2^-125 with the origin (a
     // scene at 1e37), a unit direction made every ray fail the reliability bound (`reach^3 / |d|`)
     // and be refused, though its own scaling is exact.
-    let moderate = |d: &[f32; 3]| (MODERATE_MIN..=MODERATE_MAX).contains(&d[0].abs().max(d[1].abs()).max(d[2].abs()));
+    let moderate = |d: &[f32; 3]| {
+        (MODERATE_MIN..=MODERATE_MAX).contains(&d[0].abs().max(d[1].abs()).max(d[2].abs())) && !reciprocal_overflows(d)
+    };
     if let Some(dir) = s(ray.dir, k).filter(moderate) {
         return Some((Ray { origin, dir, ..*ray }, 0));
     }
-    let j = crate::prepared::normalize::exponent_of(ray.dir.iter().fold(0.0f32, |m, x| m.max(x.abs())));
-    let dir = s(ray.dir, j)?;
+    use crate::prepared::normalize::exponent_of;
+    // The largest component to [0.5, 1), unless that leaves the smallest nonzero one subnormal:
+    // then the smallest to [2^-126, 2^-125), if the largest stays moderate.
+    let smallest = ray.dir.iter().map(|d| d.abs()).filter(|&d| d > 0.0).fold(f32::INFINITY, f32::min);
+    let j = exponent_of(largest).min(exponent_of(smallest) + 125);
+    let dir = s(ray.dir, j).filter(moderate)?;
     // t' = t * 2^(j - k): the interval scales by that, hits by its inverse.
     let e = k - j;
     Some((Ray { origin, dir, tmin: interval_scale(ray.tmin, e)?, tmax: interval_scale(ray.tmax, e)? }, e))
@@ -189,8 +208,8 @@ fn box_interval(ray: &Ray, b: &Aabb) -> Option<(f64, f64)> {
 }
 
 /// Whether `ray` surely needs no change in an unscaled scene: every origin component within
-/// `far`, some direction component above `min_dir` ([`min_reliable_dir`]) and none above
-/// [`MODERATE_MAX`]. Those bound the exact decision's `reach = scale + max|origin|` by
+/// `far`, some direction component above `min_dir` ([`min_reliable_dir`]), none above
+/// [`MODERATE_MAX`] and none subnormal. Those bound the exact decision's `reach = scale + max|origin|` by
 /// `scale + far` and its `max|d|` from below, so its slack is finite with room to spare. Only comparisons of single components, no horizontal
 /// maximum and no product: a third of what the filter cost before, and it is run over every ray
 /// of a batch (`docs/notes/*-benchmarks-embree-gap.md`, "A cheaper framing filter"). A NaN origin
@@ -201,7 +220,14 @@ fn surely_kept(ray: &Ray, far: f32, min_dir: f32) -> bool {
     let near = |i: usize| ray.origin[i].abs() <= far;
     let sized = |i: usize| ray.dir[i].abs() > min_dir;
     let capped = |i: usize| ray.dir[i].abs() <= MODERATE_MAX;
-    near(0) & near(1) & near(2) & (sized(0) | sized(1) | sized(2)) & (capped(0) & capped(1) & capped(2))
+    // Zero or normal: a subnormal component may have a reciprocal that overflows.
+    let plain = |i: usize| ray.dir[i].abs() >= f32::MIN_POSITIVE || ray.dir[i] == 0.0;
+    near(0)
+        & near(1)
+        & near(2)
+        & (sized(0) | sized(1) | sized(2))
+        & (capped(0) & capped(1) & capped(2))
+        & (plain(0) & plain(1) & plain(2))
 }
 
 /// Whether a ray that [`surely_kept`] clears is traceable ([`Ray::is_traceable`]): such a ray has
@@ -389,6 +415,7 @@ mod tests {
                 assert!(reach <= far, "cleared a far ray: {ray:?}");
                 assert!(SlabRay::with_slack(&ray, scale).slack.is_finite(), "cleared an unreliable ray: {ray:?}");
                 assert!(ray.dir.iter().all(|d| d.abs() <= MODERATE_MAX), "cleared a huge direction: {ray:?}");
+                assert!(!reciprocal_overflows(&ray.dir), "cleared a direction whose reciprocal overflows: {ray:?}");
             }
         }
         assert!(cleared > checked / 25 && cleared < checked, "{cleared} of {checked} cleared");
@@ -427,5 +454,28 @@ mod tests {
         // Directions of ordinary sizes are left as they are.
         let unit = Ray { dir: [0.0, 0.6, 0.8], tmax: 5.0, ..ray };
         assert_eq!(scaled(&unit, 0), Some((unit, 0)));
+    }
+
+    /// A fuzzed ray along `(5.05e-40, 8.27e-40, -0.25)`: `1 / 5.05e-40` overflows, and the slab
+    /// test culled a box whose x plane lay at `2.7e-44`, just off the origin, that the ray enters at
+    /// `t = 5.3e-5`. The filter sends it to the exact decision, which scales the direction by 2^5
+    /// (its smallest component normal) with its interval, or refuses it where the interval cannot
+    /// follow exactly.
+    #[test]
+    fn subnormal_direction_components_are_scaled_to_normal_or_refused() {
+        let ray = Ray { origin: [0.0; 3], tmin: 0.0, dir: [5.050_95e-40, 8.265_2e-40, -0.25], tmax: 137_439_990_000.0 };
+        assert!(reciprocal_overflows(&ray.dir));
+        assert!(!surely_kept(&ray, 48.0, min_reliable_dir(12.0, 48.0)), "the filter clears it");
+        let (r, e) = scaled(&ray, 0).expect("scales exactly");
+        assert_eq!(e, 5);
+        assert_eq!(r.dir, ray.dir.map(|d| d * 32.0));
+        assert!(r.dir.iter().all(|d| d.abs() >= f32::MIN_POSITIVE) && !reciprocal_overflows(&r.dir));
+        assert_eq!((r.origin, r.tmin, r.tmax), (ray.origin, 0.0, ray.tmax / 32.0));
+        // An interval end that loses bits when divided by 32 (the smallest subnormal): refused.
+        let inexact = Ray { tmin: f32::from_bits(1), ..ray };
+        assert_eq!(scaled(&inexact, 0), None);
+        // Components more than 2^190 apart cannot all be normal with the largest moderate.
+        let apart = Ray { dir: [1e-44, 0.0, 1e19], ..ray };
+        assert_eq!(scaled(&apart, 0), None);
     }
 }
