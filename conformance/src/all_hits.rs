@@ -153,6 +153,14 @@ pub fn exact_mismatches(triangles: &[Triangle], scene_scale: f32, rays: &[Ray], 
     out
 }
 
+/// `scene` with tree `bvh` prepared as the query cases check it: the default tracer's 8-wide tree
+/// of least node area, which the queries read ([`PreparedScene::query_tree`]), and the BVH2
+/// stack walk's layout, which traces the ray sets' closest hits.
+pub fn prepared_for_queries(scene: &raytrail_core::scene::Scene, bvh: Bvh2) -> Arc<PreparedScene> {
+    let methods = [Method::Bvh2(Bvh2Method::Stack), Method::Wide(WideMethod::BVH8_SAH)];
+    Arc::new(PreparedScene::new(scene, bvh, &methods).expect("prepare"))
+}
+
 /// Every option lists are checked under: all hits, a limit of two, merged at equal `t`, and merged
 /// with a limit of one.
 pub const OPTIONS: [AllHitsOptions; 4] = [
@@ -168,8 +176,8 @@ const RAYS: RaySetSize = RaySetSize { width: 24, height: 18, uniform_count: 256 
 
 /// The suite's all-hits case on `backend`: the shared-edge grid, the sphereflake (with a SAH and
 /// a split tree, whose cut triangles lie in several leaves), the triangle soup and the scene far
-/// from the origin, the first three smaller than the methods' cases have them, each prepared as the default tracer prepares a scene (its 8-wide tree of
-/// least node area). Under every option of [`OPTIONS`] the lists must be the brute force's bit
+/// from the origin, the first three smaller than the methods' cases have them, each prepared
+/// with [`prepared_for_queries`]. Under every option of [`OPTIONS`] the lists must be the brute force's bit
 /// for bit, and the complete ones must agree with the exact reference; panics with a loud report
 /// otherwise, or when the backend has no all-hits query.
 pub fn check_backend<B: Trace>(backend: &B) {
@@ -187,8 +195,7 @@ pub fn check_backend<B: Trace>(backend: &B) {
 
 /// [`check_backend`] on one scene with the tree `build` makes.
 fn check_scene<B: Trace>(backend: &B, named: &NamedScene, build: impl FnOnce(&NamedScene) -> Bvh2) {
-    let methods = [Method::Bvh2(Bvh2Method::Stack), Method::Wide(WideMethod::BVH8_SAH)];
-    let prepared = Arc::new(PreparedScene::new(&named.scene, build(named), &methods).expect("prepare"));
+    let prepared = prepared_for_queries(&named.scene, build(named));
     let serial = SerialBackend;
     let mut closest = |rays: &[Ray]| {
         let mut hits = vec![Hit::MISS; rays.len()];

@@ -6,12 +6,9 @@
 use crate::rays::query_points;
 use crate::scenes::{far_from_origin, shared_edge_grid, sphereflake, triangle_soup};
 use raytrail_core::bvh2::{Bvh2, SahBuilder, SbvhBuilder};
-use raytrail_core::method::{Bvh2Method, Method, WideMethod};
 use raytrail_core::nearest::{closest_point_on_triangle, NearestPoint};
-use raytrail_core::prepared::PreparedScene;
 use raytrail_core::scene::Scene;
 use raytrail_core::trace::Trace;
-use std::sync::Arc;
 
 /// The point of `scene` nearest to `p` within `radius` (inclusive), over every triangle.
 pub fn brute_force(scene: &Scene, p: [f32; 3], radius: f32) -> Option<NearestPoint> {
@@ -35,7 +32,7 @@ pub fn brute_force(scene: &Scene, p: [f32; 3], radius: f32) -> Option<NearestPoi
 
 /// The suite's nearest-point case on `backend`: points in and around the shared-edge grid, the
 /// sphereflake (with a SAH and a split tree), a triangle soup and the scene far from the origin,
-/// each prepared as the default tracer prepares a scene, with no radius, a radius of a twentieth
+/// each prepared as [`crate::all_hits::prepared_for_queries`] prepares it, with no radius, a radius of a twentieth
 /// of the scene and a radius of 0; every answer must be the brute force's bit for bit. Panics with
 /// a loud report otherwise, or when the backend has no nearest-point query.
 pub fn check_backend<B: Trace>(backend: &B) {
@@ -52,8 +49,7 @@ pub fn check_backend<B: Trace>(backend: &B) {
 
 /// [`check_backend`] on one scene with the tree `build` makes.
 fn check_scene<B: Trace>(backend: &B, name: &str, scene: &Scene, build: impl FnOnce(&Scene) -> Bvh2) {
-    let methods = [Method::Bvh2(Bvh2Method::Stack), Method::Wide(WideMethod::BVH8_SAH)];
-    let prepared = Arc::new(PreparedScene::new(scene, build(scene), &methods).expect("prepare"));
+    let prepared = crate::all_hits::prepared_for_queries(scene, build(scene));
     let device = backend.prepare(prepared).expect("prepare on the backend");
     let points = query_points(scene, 300, 0.5, 17);
     let size = (scene.bounds().max - scene.bounds().min).max_element();

@@ -8,26 +8,23 @@
 
 mod common;
 
-use raytrail_conformance::all_hits::OPTIONS;
+use raytrail_conformance::all_hits::{prepared_for_queries, OPTIONS};
 use raytrail_conformance::rays::{ray_sets, RaySetSize};
 use raytrail_conformance::scenes::{degenerate_stack, DEGENERATE_STACK_LAYERS, SCENE_SEED};
 use raytrail_conformance::SerialBackend;
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::bvh2::SahBuilder;
-use raytrail_core::method::{Bvh2Method, Method, WideMethod};
-use raytrail_core::prepared::PreparedScene;
+use raytrail_core::method::Bvh2Method;
 use raytrail_core::trace::{Trace, TraceOptions};
 use raytrail_core::{Hit, Ray};
 use raytrail_wgpu::WgpuBackend;
-use std::sync::Arc;
 
 #[test]
 fn lists_longer_than_a_first_slot_are_the_cores_bit_for_bit() {
     let Some(gpu) = common::open_or_skip("the long all-hits lists test", WgpuBackend::new) else { return };
     let scene = degenerate_stack(DEGENERATE_STACK_LAYERS, SCENE_SEED);
     let bvh = SahBuilder::default().build(scene.triangles()).expect("SAH build");
-    let methods = [Method::Bvh2(Bvh2Method::Stack), Method::Wide(WideMethod::BVH8_SAH)];
-    let prepared = Arc::new(PreparedScene::new(&scene, bvh, &methods).expect("prepare"));
+    let prepared = prepared_for_queries(&scene, bvh);
     let mut closest = |rays: &[Ray]| {
         let mut hits = vec![Hit::MISS; rays.len()];
         SerialBackend.trace(&prepared, rays, &TraceOptions::new(Bvh2Method::Stack), &mut hits).expect("trace");
