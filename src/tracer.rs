@@ -18,6 +18,7 @@ use raytrail_core::nearest::NearestPoint;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::scene::{Mesh, Scene};
 use raytrail_core::trace::{Report, Trace, TraceOptions};
+use raytrail_core::trace_order::TraceOrder;
 use raytrail_core::{Hit, Ray};
 use raytrail_cpu::{CpuBackend, CpuScene};
 use std::cell::RefCell;
@@ -322,13 +323,16 @@ impl Tracer {
     }
 
     /// The method this tracer would trace `rays` with for `query`: the one it was built for, or
-    /// the fastest of [`AUTO_WALKS`] on a sample of a batch of at least [`AUTO_MIN_RAYS`] rays.
+    /// for a batch of at least [`AUTO_MIN_RAYS`] rays, the walk for sorted rays where it sorts the
+    /// batch ([`crate::analysis::order::sorted_walk`]) and otherwise the fastest of [`AUTO_WALKS`]
+    /// on a sample.
     pub fn method_for(&self, rays: &[Ray], query: Query) -> Result<Method, Error> {
         Ok(match self.method {
             Some(m) => m,
-            None if rays.len() >= AUTO_MIN_RAYS => {
-                choose_among(&AUTO_WALKS, &self.backend, &self.scene, rays, query)?.method
-            }
+            None if rays.len() >= AUTO_MIN_RAYS => match crate::analysis::order::sorted_walk(rays) {
+                Some(m) => m,
+                None => choose_among(&AUTO_WALKS, &self.backend, &self.scene, rays, query)?.method,
+            },
             None => AUTO_WALKS[0],
         })
     }
@@ -342,7 +346,9 @@ impl Tracer {
             }
         }
         let method = self.method_for(rays, query)?;
-        Ok(self.backend.trace(&self.scene, rays, &TraceOptions::new(method).query(query), hits)?)
+        // `auto` also picks the order: a large batch in no useful order is sorted first.
+        let order = if self.method.is_none() { TraceOrder::for_batch(rays) } else { TraceOrder::AsGiven };
+        Ok(self.backend.trace(&self.scene, rays, &TraceOptions::new(method).query(query).order(order), hits)?)
     }
 }
 

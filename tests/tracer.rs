@@ -220,3 +220,34 @@ fn a_refitted_tracer_answers_as_one_built_from_the_moved_vertices() {
     assert!(matches!(err, Error::Core(raytrail::core::Error::TreeMismatch { .. })), "{err:?}");
     assert!(tracer.intersect(&primary(&scene, 64, 48)).unwrap().iter().zip(&before).all(|(a, b)| a.same_as(b)));
 }
+
+/// A large batch in no order is sorted by `auto` (and walked in packets) and answers as the stack
+/// method does, hit for hit in the caller's order; a camera's batch is traced as given.
+#[test]
+fn auto_sorts_a_large_shuffled_batch_and_answers_in_the_given_order() {
+    use raytrail::core::trace_order::{TraceOrder, SORT_MIN_RAYS};
+    let scene = generated_scene("sphereflake").scene;
+    let (vertices, triangles) = arrays(&scene);
+    let tracer = Tracer::new(&vertices, &triangles).unwrap();
+    let (lo, hi) = (scene.bounds().min, scene.bounds().max);
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let rays: Vec<Ray> = (0..SORT_MIN_RAYS + 1000)
+        .map(|_| {
+            let o = lo + (hi - lo) * Vec3::new(next(), next(), next());
+            Ray::new(o, Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5), 0.0, f32::INFINITY)
+        })
+        .collect();
+    assert_eq!(TraceOrder::for_batch(&rays), TraceOrder::Sorted);
+    assert_eq!(tracer.method_for(&rays, Query::Closest).unwrap(), raytrail::analysis::order::SORTED_WALK);
+    let hits = tracer.intersect(&rays).unwrap();
+    assert_eq!(hits, stack_hits(&scene, &rays, Query::Closest));
+    assert!(hits.iter().filter(|h| h.is_hit()).count() > rays.len() / 10, "too few hits to compare");
+    let camera = primary(&scene, 400, 400);
+    assert_eq!(TraceOrder::for_batch(&camera), TraceOrder::AsGiven);
+}

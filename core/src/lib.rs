@@ -38,6 +38,7 @@ pub mod scene;
 pub mod stream;
 #[cfg(feature = "alloc")]
 pub mod trace;
+pub mod trace_order;
 pub mod traverse;
 pub mod wide;
 

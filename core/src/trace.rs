@@ -6,6 +6,7 @@ use crate::nearest::NearestPoint;
 use crate::observe::Counters;
 use crate::prepared::PreparedScene;
 use crate::stream::{StreamParams, StreamStats};
+use crate::trace_order::TraceOrder;
 use crate::{Error, Hit, Ray};
 use alloc::sync::Arc;
 use alloc::vec::Vec;
@@ -54,6 +55,8 @@ pub struct TraceOptions {
     pub record: Record,
     /// Parameters of the stream methods (ignored by the others).
     pub stream: StreamParams,
+    /// The order the rays are traced in ([`TraceOrder`]): the hits are the same in any order.
+    pub order: TraceOrder,
 }
 
 impl TraceOptions {
@@ -65,6 +68,7 @@ impl TraceOptions {
             triangle_test: TriangleTestKind::Watertight,
             record: Record::Nothing,
             stream: StreamParams::default(),
+            order: TraceOrder::AsGiven,
         }
     }
 
@@ -89,6 +93,12 @@ impl TraceOptions {
     /// The same options with `params` for the stream methods.
     pub fn stream(mut self, params: StreamParams) -> Self {
         self.stream = params;
+        self
+    }
+
+    /// The same options tracing the rays in `order`.
+    pub fn order(mut self, order: TraceOrder) -> Self {
+        self.order = order;
         self
     }
 }

@@ -12,6 +12,7 @@
 
 pub mod choice;
 pub mod needs;
+pub mod order;
 pub mod sample;
 #[cfg(feature = "gpu")]
 pub mod shaders;

@@ -1,4 +1,5 @@
 use crate::chunk::Chunk;
+use crate::trace_order::SortScratch;
 use rayon::prelude::*;
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
 use raytrail_core::method::Method;
@@ -7,6 +8,7 @@ use raytrail_core::nearest::NearestPoint;
 use raytrail_core::observe::Counters;
 use raytrail_core::prepared::PreparedScene;
 use raytrail_core::trace::{check_buffers, Record, Report, Trace, TraceOptions};
+use raytrail_core::trace_order::TraceOrder;
 use raytrail_core::traverse::packets::GROUPING_RAYS;
 use raytrail_core::wide::STREAM_RAYS;
 use raytrail_core::{Error, Hit, Ray};
@@ -32,6 +34,7 @@ fn chunk_rays(method: Method) -> usize {
 #[derive(Debug, Default)]
 pub struct CpuBackend {
     pool: Option<rayon::ThreadPool>,
+    sort_buffers: SortScratch,
 }
 
 /// A scene as the CPU backend holds it: shared, read in place.
@@ -41,12 +44,15 @@ pub struct CpuScene(pub Arc<PreparedScene>);
 impl CpuBackend {
     /// A backend on rayon's global pool (all cores).
     pub fn new() -> Self {
-        Self { pool: None }
+        Self { pool: None, sort_buffers: SortScratch::default() }
     }
 
     /// A backend on its own pool of `threads` threads (1: single-threaded).
     pub fn with_threads(threads: usize) -> Result<Self, rayon::ThreadPoolBuildError> {
-        Ok(Self { pool: Some(rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build()?) })
+        Ok(Self {
+            pool: Some(rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build()?),
+            sort_buffers: SortScratch::default(),
+        })
     }
 
     /// Threads this backend traces with.
@@ -84,6 +90,10 @@ impl Trace for CpuBackend {
     /// they are in cache: a pass of its own over a batch cost a tenth of a fast method's trace of
     /// primary rays); where one does, the batch is framed and traced again.
     fn trace(&self, scene: &CpuScene, rays: &[Ray], opts: &TraceOptions, hits: &mut [Hit]) -> Result<Report, Error> {
+        // The stream method sorts the rays its own way (Garanzha & Loop's ray hashing).
+        if opts.order == TraceOrder::Sorted && !matches!(opts.method, Method::Stream(_)) {
+            return crate::trace_order::trace_sorted(self, &self.sort_buffers, scene, rays, opts, hits);
+        }
         if let Some(report) = self.trace_in_frame(scene, rays, opts, hits, Framing::Check)? {
             return Ok(report);
         }

@@ -17,6 +17,7 @@ mod refit;
 mod stream;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod test_rng;
+mod trace_order;
 mod trail;
 mod wide;
 #[cfg(target_arch = "x86_64")]

@@ -174,7 +174,9 @@ fn bench_scene(
                 targets.push(Box::new(RaytrailCpu::stream(m, params, cpu.clone())));
             }
         } else {
-            targets.push(Box::new(RaytrailCpu::new(m, cpu.clone())));
+            for &order in &opts.trace_orders {
+                targets.push(Box::new(RaytrailCpu::new(m, cpu.clone()).in_order(order)));
+            }
         }
     }
     let auto_log = if opts.auto {

@@ -8,6 +8,7 @@ use crate::flags::{LoadFlags, AUTO, BUILDERS};
 use clap::Parser;
 use raytrail::core::method::Method;
 use raytrail::core::stream::{StreamParams, MAX_PACKET};
+use raytrail::core::trace_order::TraceOrder;
 use raytrail::gpu::{Dispatch, GpuConfig};
 use raytrail::Builder;
 use std::ffi::OsString;
@@ -70,6 +71,8 @@ pub struct Options {
     pub view: ViewChoice,
     /// The order of the rays ([`RayOrder`]).
     pub order: RayOrder,
+    /// The trace orders each raytrail CPU method is measured in (`--trace-order`).
+    pub trace_orders: Vec<TraceOrder>,
     /// Fail on mesh elements that are not triangles or polygons instead of skipping them.
     pub strict: bool,
     /// Parameter sets of the stream method: one target per set (the first is the default's).
@@ -153,6 +156,11 @@ pub struct BenchArgs {
     /// rays row by row), shuffled (secondary rays in no order, as a path tracer's later bounces)
     #[arg(long, default_value = "morton", value_parser = RayOrder::ALL.map(RayOrder::name))]
     pub order: String,
+    /// The order raytrail's CPU methods trace the rays in: given (as generated), sorted (each
+    /// method sorts the batch by origin and octant first, its time included; the target is named
+    /// METHOD/sorted) or both
+    #[arg(long, default_value = "given", value_parser = ["given", "sorted", "both"])]
+    pub trace_order: String,
     #[command(flatten)]
     pub load: LoadFlags,
 }
@@ -297,6 +305,11 @@ impl Options {
             no_gpu: a.no_gpu,
             view: ViewChoice::from_name(&a.view)?,
             order: RayOrder::from_name(&a.order).ok_or_else(|| format!("--order: unknown order '{}'", a.order))?,
+            trace_orders: match a.trace_order.as_str() {
+                "sorted" => vec![TraceOrder::Sorted],
+                "both" => vec![TraceOrder::AsGiven, TraceOrder::Sorted],
+                _ => vec![TraceOrder::AsGiven],
+            },
             strict: a.load.strict,
         })
     }
@@ -408,6 +421,10 @@ mod tests {
         let o = parse("--methods auto --peers none").unwrap();
         assert!(o.auto && o.methods.is_empty());
         assert_eq!(o.baseline, "auto");
+        assert_eq!(parse("--peers none").unwrap().trace_orders, vec![TraceOrder::AsGiven]);
+        let o = parse("--trace-order both --peers none").unwrap();
+        assert_eq!(o.trace_orders, vec![TraceOrder::AsGiven, TraceOrder::Sorted]);
+        assert!(parse("--trace-order backwards").is_err());
         let e = parse("--methods automatic").unwrap_err();
         assert!(e.contains("unknown method 'automatic'") && e.contains(", auto)"), "{e}");
     }

@@ -5,6 +5,7 @@ use raytrail::core::method::{Method, Query, Structure};
 use raytrail::core::observe::Counters;
 use raytrail::core::stream::{StreamParams, StreamStats};
 use raytrail::core::trace::{Record, Trace, TraceOptions};
+use raytrail::core::trace_order::TraceOrder;
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 use raytrail::gpu::KernelTiming;
@@ -132,6 +133,7 @@ pub struct RaytrailCpu {
     method: Method,
     name: String,
     stream: StreamParams,
+    order: TraceOrder,
     backend: CpuBackend,
     scene: CpuScene,
 }
@@ -143,9 +145,19 @@ impl RaytrailCpu {
             method,
             name: method.name().to_string(),
             stream: StreamParams::default(),
+            order: TraceOrder::AsGiven,
             backend: CpuBackend::new(),
             scene,
         }
+    }
+
+    /// The same target tracing in `order`, named `METHOD/sorted` for [`TraceOrder::Sorted`].
+    pub fn in_order(mut self, order: TraceOrder) -> Self {
+        if order == TraceOrder::Sorted {
+            self.name = format!("{}/sorted", self.name);
+        }
+        self.order = order;
+        self
     }
 
     /// The stream method with `params`, named `stream` for the defaults and
@@ -156,12 +168,12 @@ impl RaytrailCpu {
         } else {
             format!("{}/{}/{}", method.name(), params.max_packet, params.origin_cell_fraction)
         };
-        Self { method, name, stream: params, backend: CpuBackend::new(), scene }
+        Self { method, name, stream: params, order: TraceOrder::AsGiven, backend: CpuBackend::new(), scene }
     }
 
     /// The options of a trace with `query` recording `record`.
     fn options(&self, query: Query, record: Record) -> TraceOptions {
-        TraceOptions::new(self.method).query(query).record(record).stream(self.stream)
+        TraceOptions::new(self.method).query(query).record(record).stream(self.stream).order(self.order)
     }
 
     /// Traces with `record`, returning the counters when recorded.

@@ -8,8 +8,10 @@
 
 use super::target::{BenchTarget, RaytrailCpu, TargetKind, Work};
 use raytrail::analysis::choice::Choice;
+use raytrail::analysis::order::sorted_walk;
 use raytrail::analysis::sample::choose_on_cpu;
 use raytrail::core::method::{Method, Query};
+use raytrail::core::trace_order::TraceOrder;
 use raytrail::core::{Hit, Ray};
 use raytrail::cpu::{CpuBackend, CpuScene};
 use std::sync::{Arc, Mutex};
@@ -23,6 +25,7 @@ pub struct AutoTarget {
     scene: CpuScene,
     backend: CpuBackend,
     chosen: Mutex<Option<(BatchKey, Method)>>,
+    fixed: Mutex<Option<(Method, TraceOrder, Arc<RaytrailCpu>)>>,
     /// Every choice made, in order, with the batch's length (shared with the caller, who prints
     /// them).
     pub choices: Arc<Mutex<Vec<(usize, Choice)>>>,
@@ -31,7 +34,13 @@ pub struct AutoTarget {
 impl AutoTarget {
     /// The target over `scene`, which must hold the candidates' tables.
     pub fn new(scene: CpuScene) -> Self {
-        AutoTarget { scene, backend: CpuBackend::new(), chosen: Mutex::new(None), choices: Arc::default() }
+        AutoTarget {
+            scene,
+            backend: CpuBackend::new(),
+            chosen: Mutex::new(None),
+            fixed: Mutex::new(None),
+            choices: Arc::default(),
+        }
     }
 
     /// The method for this batch: the one chosen before, or a new choice.
@@ -43,18 +52,33 @@ impl AutoTarget {
                 return Ok(m);
             }
         }
-        let choice = pool
-            .install(|| choose_on_cpu(&self.backend, &self.scene, rays, query))
-            .map_err(|e| format!("auto: {e}"))?;
+        let choice = match sorted_walk(rays) {
+            // A batch `auto` sorts goes to one walk, untimed.
+            Some(method) => Choice { method, timed: Vec::new(), cost_seconds: 0.0, lists: None },
+            None => pool
+                .install(|| choose_on_cpu(&self.backend, &self.scene, rays, query))
+                .map_err(|e| format!("auto: {e}"))?,
+        };
         let m = choice.method;
         *chosen = Some((key, m));
         self.choices.lock().map_err(|_| "auto: a trace panicked".to_string())?.push((rays.len(), choice));
         Ok(m)
     }
 
-    /// The fixed-method target of the method chosen for this batch.
-    fn fixed(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<RaytrailCpu, String> {
-        Ok(RaytrailCpu::new(self.method(pool, rays, query)?, self.scene.clone()))
+    /// The fixed-method target of the method chosen for this batch, in the order `auto` traces
+    /// it in ([`TraceOrder::for_batch`]). Kept from one pass to the next, with its sort buffers.
+    fn fixed(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Arc<RaytrailCpu>, String> {
+        let method = self.method(pool, rays, query)?;
+        let order = TraceOrder::for_batch(rays);
+        let mut fixed = self.fixed.lock().map_err(|_| "auto: a trace panicked".to_string())?;
+        match &*fixed {
+            Some((m, o, target)) if (*m, *o) == (method, order) => Ok(target.clone()),
+            _ => {
+                let target = Arc::new(RaytrailCpu::new(method, self.scene.clone()).in_order(order));
+                *fixed = Some((method, order, target.clone()));
+                Ok(target)
+            }
+        }
     }
 }
 

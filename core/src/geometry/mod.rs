@@ -5,10 +5,12 @@ mod aabb;
 #[cfg(feature = "alloc")]
 pub(crate) mod clip;
 mod hit;
+mod morton;
 mod ray;
 mod triangle;
 
 pub use aabb::Aabb;
 pub use hit::Hit;
+pub(crate) use morton::morton3;
 pub use ray::Ray;
 pub use triangle::Triangle;

@@ -2,6 +2,7 @@
 //! virtual grids and merged into a 32-bit key; rays with equal keys are taken to be coherent.
 
 use super::StreamParams;
+use crate::geometry::morton3;
 use crate::{Aabb, Ray};
 use glam::Vec3;
 
@@ -101,18 +102,6 @@ fn ceil_u32(x: f32) -> u32 {
     } else {
         c
     }
-}
-
-/// Interleaves the low 10 bits of three values.
-fn morton3(x: u32, y: u32, z: u32) -> u32 {
-    fn spread(v: u32) -> u32 {
-        let mut v = v & 0x3ff;
-        v = (v | (v << 16)) & 0x0300_00ff;
-        v = (v | (v << 8)) & 0x0300_f00f;
-        v = (v | (v << 4)) & 0x030c_30c3;
-        (v | (v << 2)) & 0x0924_9249
-    }
-    spread(x) | (spread(y) << 1) | (spread(z) << 2)
 }
 
 /// Interleaves the low 10 bits of two values.

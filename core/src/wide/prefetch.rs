@@ -37,25 +37,14 @@ pub const PREFETCH_ABOVE_BYTES: usize = 16 << 20;
 ///   (`docs/notes/*-benchmarks-packet-leaves.md`, "Prefetching in the packets' handed-over");
 ///   in streams 1.01-1.03 from outside and 1.00-1.02 from inside
 ///   (`docs/notes/*-benchmarks-stream-prefetch.md`, "Streams that prefetch").
-/// - Coherence is judged on up to 32 pairs of neighbouring rays spread over the batch: where at
-///   least a quarter of them point within about 18 degrees of each other (as neighbouring camera
-///   rays do), the previous ray will have brought the nodes in. Two directions drawn at random over
-///   a hemisphere pass that test about one time in twenty.
+/// - Incoherent: neighbouring rays that do not look coherent
+///   ([`looks_coherent`](crate::trace_order::looks_coherent)), or the previous ray will have
+///   brought the nodes in.
 pub fn worth_prefetching(tree_bytes: usize, rays: &[Ray], query: Query, shared: bool) -> bool {
     if (query != Query::Closest && !shared) || tree_bytes <= PREFETCH_ABOVE_BYTES || rays.len() < 2 {
         return false;
     }
-    let pairs = (rays.len() - 1).min(32);
-    let step = (rays.len() - 1) / pairs;
-    let close = (0..pairs)
-        .filter(|k| {
-            let (a, b) = (rays[k * step].dir(), rays[k * step + 1].dir());
-            // cos > 0.95 without a square root: `a.b > 0` and `(a.b)^2 > 0.95^2 |a|^2 |b|^2`.
-            let dot = a.dot(b);
-            dot > 0.0 && dot * dot > 0.9025 * a.length_squared() * b.length_squared()
-        })
-        .count();
-    close * 4 < pairs
+    !crate::trace_order::looks_coherent(rays)
 }
 
 /// Bytes of a cache line, the unit a prefetch brings in.
