@@ -324,16 +324,26 @@ impl Tracer {
 
     /// The method this tracer would trace `rays` with for `query`: the one it was built for, or
     /// for a batch of at least [`AUTO_MIN_RAYS`] rays, the walk for sorted rays where it sorts the
-    /// batch ([`crate::analysis::order::sorted_walk`]) and otherwise the fastest of [`AUTO_WALKS`]
-    /// on a sample.
+    /// batch ([`crate::analysis::order::sorted_walk`]: large, in no useful order, slow per ray)
+    /// and otherwise the fastest of [`AUTO_WALKS`] on a sample.
     pub fn method_for(&self, rays: &[Ray], query: Query) -> Result<Method, Error> {
+        Ok(self.plan_for(rays, query)?.0)
+    }
+
+    /// [`Tracer::method_for`] with the order the batch is traced in: sorted where `auto` sorts it.
+    fn plan_for(&self, rays: &[Ray], query: Query) -> Result<(Method, TraceOrder), Error> {
         Ok(match self.method {
-            Some(m) => m,
-            None if rays.len() >= AUTO_MIN_RAYS => match crate::analysis::order::sorted_walk(rays) {
-                Some(m) => m,
-                None => choose_among(&AUTO_WALKS, &self.backend, &self.scene, rays, query)?.method,
-            },
-            None => AUTO_WALKS[0],
+            Some(m) => (m, TraceOrder::AsGiven),
+            None if rays.len() >= AUTO_MIN_RAYS => {
+                match crate::analysis::order::sorted_walk(&self.backend, &self.scene, rays, query)?.0 {
+                    Some(m) => (m, TraceOrder::Sorted),
+                    None => (
+                        choose_among(&AUTO_WALKS, &self.backend, &self.scene, rays, query)?.method,
+                        TraceOrder::AsGiven,
+                    ),
+                }
+            }
+            None => (AUTO_WALKS[0], TraceOrder::AsGiven),
         })
     }
 
@@ -345,9 +355,8 @@ impl Tracer {
                 return Err(Error::UntraceableRays { count, first });
             }
         }
-        let method = self.method_for(rays, query)?;
-        // `auto` also picks the order: a large batch in no useful order is sorted first.
-        let order = if self.method.is_none() { TraceOrder::for_batch(rays) } else { TraceOrder::AsGiven };
+        // `auto` also picks the order: a large, slow batch in no useful order is sorted first.
+        let (method, order) = self.plan_for(rays, query)?;
         Ok(self.backend.trace(&self.scene, rays, &TraceOptions::new(method).query(query).order(order), hits)?)
     }
 }

@@ -221,10 +221,10 @@ fn a_refitted_tracer_answers_as_one_built_from_the_moved_vertices() {
     assert!(tracer.intersect(&primary(&scene, 64, 48)).unwrap().iter().zip(&before).all(|(a, b)| a.same_as(b)));
 }
 
-/// A large batch in no order is sorted by `auto` (and walked in packets) and answers as the stack
-/// method does, hit for hit in the caller's order; a camera's batch is traced as given.
+/// A large batch in no order, which `auto` may sort (and walk in packets), answers as the stack
+/// method does, hit for hit in the caller's order; a camera's batch is never sorted.
 #[test]
-fn auto_sorts_a_large_shuffled_batch_and_answers_in_the_given_order() {
+fn auto_on_a_large_shuffled_batch_answers_in_the_given_order() {
     use raytrail::core::trace_order::{TraceOrder, SORT_MIN_RAYS};
     let scene = generated_scene("sphereflake").scene;
     let (vertices, triangles) = arrays(&scene);
@@ -244,7 +244,10 @@ fn auto_sorts_a_large_shuffled_batch_and_answers_in_the_given_order() {
         })
         .collect();
     assert_eq!(TraceOrder::for_batch(&rays), TraceOrder::Sorted);
-    assert_eq!(tracer.method_for(&rays, Query::Closest).unwrap(), raytrail::analysis::order::SORTED_WALK);
+    // Whether it sorts also depends on how slow the rays are on this machine (a timed sample):
+    // either way the answers are the stack method's.
+    let method = tracer.method_for(&rays, Query::Closest).unwrap();
+    assert!(method == raytrail::analysis::order::SORTED_WALK || AUTO_WALKS.contains(&method), "{method}");
     let hits = tracer.intersect(&rays).unwrap();
     assert_eq!(hits, stack_hits(&scene, &rays, Query::Closest));
     assert!(hits.iter().filter(|h| h.is_hit()).count() > rays.len() / 10, "too few hits to compare");

@@ -26,11 +26,16 @@ pub enum TraceOrder {
 
 impl TraceOrder {
     /// The order `auto` traces a batch in: [`TraceOrder::Sorted`] for a batch of at least
-    /// [`SORT_MIN_RAYS`] whose neighbouring rays do not look coherent ([`looks_coherent`]),
-    /// [`TraceOrder::AsGiven`] otherwise (a camera's rays, shadow rays to one light, a batch a
-    /// renderer has sorted: sorting again would cost without gaining).
+    /// [`SORT_MIN_RAYS`] whose neighbouring rays neither point alike ([`looks_coherent`]) nor
+    /// start close together ([`origins_look_scattered`]), [`TraceOrder::AsGiven`] otherwise: a
+    /// camera's rays, shadow rays to one light, and a renderer's bounces in pixel order (several
+    /// rays from one hit point, then the next pixel's), where sorting costs more than it gains.
+    /// Ambient-occlusion rays in the bench's pixel order, sorted, ran at 0.41-0.85 of the fastest
+    /// method as given: fast any-hit rays, whose neighbours already share their nodes
+    /// (`docs/notes/*-sorted-trace-order.md`, "Which batches to sort"). `auto` also sorts only
+    /// rays slow enough to pay for it (`raytrail::analysis::order`).
     pub fn for_batch(rays: &[Ray]) -> TraceOrder {
-        if rays.len() >= SORT_MIN_RAYS && !looks_coherent(rays) {
+        if rays.len() >= SORT_MIN_RAYS && !looks_coherent(rays) && origins_look_scattered(rays) {
             TraceOrder::Sorted
         } else {
             TraceOrder::AsGiven
@@ -42,6 +47,14 @@ impl TraceOrder {
 /// close together, and a smaller batch holds fewer of them per cell of the scene.
 pub const SORT_MIN_RAYS: usize = 1 << 17;
 
+/// Up to 32 pairs of neighbouring rays spread evenly over the batch: what the batch tests judge
+/// its order by.
+fn neighbour_pairs(rays: &[Ray]) -> impl Iterator<Item = (&Ray, &Ray)> {
+    let pairs = rays.len().saturating_sub(1).min(32);
+    let step = rays.len().saturating_sub(1) / pairs.max(1);
+    (0..pairs).map(move |k| (&rays[k * step], &rays[k * step + 1]))
+}
+
 /// Whether neighbouring rays of the batch point alike, judged on up to 32 pairs of neighbours
 /// spread over it: at least a quarter of them within about 18 degrees of each other, as
 /// neighbouring camera rays are. Two directions drawn at random over a hemisphere pass that test
@@ -50,17 +63,36 @@ pub fn looks_coherent(rays: &[Ray]) -> bool {
     if rays.len() < 2 {
         return true;
     }
-    let pairs = (rays.len() - 1).min(32);
-    let step = (rays.len() - 1) / pairs;
-    let close = (0..pairs)
-        .filter(|k| {
-            let (a, b) = (rays[k * step].dir(), rays[k * step + 1].dir());
-            // cos > 0.95 without a square root: `a.b > 0` and `(a.b)^2 > 0.95^2 |a|^2 |b|^2`.
-            let dot = a.dot(b);
-            dot > 0.0 && dot * dot > 0.9025 * a.length_squared() * b.length_squared()
-        })
-        .count();
+    let (mut pairs, mut close) = (0, 0);
+    for (a, b) in neighbour_pairs(rays) {
+        let (a, b) = (a.dir(), b.dir());
+        // cos > 0.95 without a square root: `a.b > 0` and `(a.b)^2 > 0.95^2 |a|^2 |b|^2`.
+        let dot = a.dot(b);
+        pairs += 1;
+        close += usize::from(dot > 0.0 && dot * dot > 0.9025 * a.length_squared() * b.length_squared());
+    }
     close * 4 >= pairs
+}
+
+/// Whether neighbouring rays of the batch start far apart, judged on the same pairs as
+/// [`looks_coherent`]: fewer than a quarter of them start within 1/32 of the diagonal of the box
+/// of the pairs' origins. Two origins drawn at random in a room pass that test well under one
+/// time in a hundred; rays in pixel order fail it (bounces of one pixel share their origin, the
+/// next pixel's start beside them).
+pub fn origins_look_scattered(rays: &[Ray]) -> bool {
+    let mut bounds = Aabb::EMPTY;
+    for (a, b) in neighbour_pairs(rays) {
+        bounds = bounds.grow(a.origin()).grow(b.origin());
+    }
+    let extent = bounds.max - bounds.min;
+    let near = extent.length_squared() / (32.0 * 32.0);
+    let (mut pairs, mut close) = (0, 0);
+    for (a, b) in neighbour_pairs(rays) {
+        pairs += 1;
+        // NaN distances (non-finite origins) count as far; an infinite box makes every pair near.
+        close += usize::from((a.origin() - b.origin()).length_squared() <= near);
+    }
+    pairs > 0 && close * 4 < pairs
 }
 
 /// Bits of each origin axis's cell index in [`OriginOctantKey`]: `3 x 9` bits of Morton code below
@@ -110,6 +142,8 @@ impl OriginOctantKey {
 #[cfg(test)]
 mod tests {
     use super::*;
+    extern crate alloc;
+    use alloc::vec::Vec;
 
     fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
         Ray { origin: o, tmin: 0.0, dir: d, tmax: f32::INFINITY }
@@ -123,6 +157,29 @@ mod tests {
         let other_octant = k.key(&ray([0.1, 0.1, 0.1], [-1.0, 1.0, 1.0]));
         assert!(near < far && far < other_octant, "{near} {far} {other_octant}");
         assert_eq!(k.key(&ray([1.0, 1.0, 1.0], [-0.0, -1.0, -1.0])), (1 << 30) - 1);
+    }
+
+    /// Shuffled rays are sorted; rays in pixel order (four bounces per origin, origins side by
+    /// side) and rays of one camera are not; a small batch is not.
+    #[test]
+    fn only_large_batches_in_no_order_are_sorted() {
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        };
+        let n = SORT_MIN_RAYS;
+        let shuffled: Vec<Ray> = (0..n).map(|_| ray([next(), next(), next()], [next(), next(), next()])).collect();
+        assert_eq!(TraceOrder::for_batch(&shuffled), TraceOrder::Sorted);
+        assert_eq!(TraceOrder::for_batch(&shuffled[..n - 1]), TraceOrder::AsGiven);
+        let pixel_order: Vec<Ray> =
+            (0..n).map(|i| ray([(i / 4) as f32 * 1e-5, 0.0, 0.0], [next(), next(), next()])).collect();
+        assert!(!looks_coherent(&pixel_order) && !origins_look_scattered(&pixel_order));
+        assert_eq!(TraceOrder::for_batch(&pixel_order), TraceOrder::AsGiven);
+        let camera: Vec<Ray> = (0..n).map(|i| ray([0.0; 3], [1.0, (i % 512) as f32 * 1e-3, 0.2])).collect();
+        assert_eq!(TraceOrder::for_batch(&camera), TraceOrder::AsGiven);
     }
 
     #[test]

@@ -24,7 +24,7 @@ type BatchKey = (usize, usize, Query, usize);
 pub struct AutoTarget {
     scene: CpuScene,
     backend: CpuBackend,
-    chosen: Mutex<Option<(BatchKey, Method)>>,
+    chosen: Mutex<Option<(BatchKey, Method, TraceOrder)>>,
     fixed: Mutex<Option<(Method, TraceOrder, Arc<RaytrailCpu>)>>,
     /// Every choice made, in order, with the batch's length (shared with the caller, who prints
     /// them).
@@ -43,33 +43,37 @@ impl AutoTarget {
         }
     }
 
-    /// The method for this batch: the one chosen before, or a new choice.
-    fn method(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Method, String> {
+    /// The method and order for this batch: the ones chosen before, or a new choice.
+    fn method(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<(Method, TraceOrder), String> {
         let key = (rays.as_ptr() as usize, rays.len(), query, pool.current_num_threads());
         let mut chosen = self.chosen.lock().map_err(|_| "auto: a trace panicked".to_string())?;
-        if let Some((k, m)) = *chosen {
+        if let Some((k, m, o)) = *chosen {
             if k == key {
-                return Ok(m);
+                return Ok((m, o));
             }
         }
-        let choice = match sorted_walk(rays) {
-            // A batch `auto` sorts goes to one walk, untimed.
-            Some(method) => Choice { method, timed: Vec::new(), cost_seconds: 0.0, lists: None },
-            None => pool
-                .install(|| choose_on_cpu(&self.backend, &self.scene, rays, query))
-                .map_err(|e| format!("auto: {e}"))?,
-        };
+        let (choice, order) = pool
+            .install(|| match sorted_walk(&self.backend, &self.scene, rays, query)? {
+                // A batch `auto` sorts goes to one walk; its cost is the sample's timing.
+                (Some(method), cost_seconds) => {
+                    Ok((Choice { method, timed: Vec::new(), cost_seconds, lists: None }, TraceOrder::Sorted))
+                }
+                (None, probe) => choose_on_cpu(&self.backend, &self.scene, rays, query).map(|mut c| {
+                    c.cost_seconds += probe;
+                    (c, TraceOrder::AsGiven)
+                }),
+            })
+            .map_err(|e| format!("auto: {e}"))?;
         let m = choice.method;
-        *chosen = Some((key, m));
+        *chosen = Some((key, m, order));
         self.choices.lock().map_err(|_| "auto: a trace panicked".to_string())?.push((rays.len(), choice));
-        Ok(m)
+        Ok((m, order))
     }
 
     /// The fixed-method target of the method chosen for this batch, in the order `auto` traces
-    /// it in ([`TraceOrder::for_batch`]). Kept from one pass to the next, with its sort buffers.
+    /// it in. Kept from one pass to the next, with its sort buffers.
     fn fixed(&self, pool: &rayon::ThreadPool, rays: &[Ray], query: Query) -> Result<Arc<RaytrailCpu>, String> {
-        let method = self.method(pool, rays, query)?;
-        let order = TraceOrder::for_batch(rays);
+        let (method, order) = self.method(pool, rays, query)?;
         let mut fixed = self.fixed.lock().map_err(|_| "auto: a trace panicked".to_string())?;
         match &*fixed {
             Some((m, o, target)) if (*m, *o) == (method, order) => Ok(target.clone()),
