@@ -135,6 +135,23 @@ fn reciprocal_overflows(d: &[f32; 3]) -> bool {
     d.iter().any(|&x| x != 0.0 && (1.0 / x).is_infinite())
 }
 
+/// Whether the smallest nonzero component of direction `d` lies more than `2^126` below its
+/// largest: the watertight test's shear (a component over the largest) is then subnormal or zero,
+/// and the test traces another ray (a fuzzed ray along `(-0, 7e-45, 2.3e11)`, its shear `3e-56`
+/// flushed to 0, hit a triangle at `t < 0` where the ray is outside the triangle's half-space).
+/// Scaling by a power of two keeps the ratio, so no framing helps: such a ray is refused.
+fn shear_not_normal(d: &[f32; 3]) -> bool {
+    let largest = d.iter().fold(0.0f64, |m, &x| m.max(f64::from(x.abs())));
+    d.iter().any(|&x| x != 0.0 && f64::from(x.abs()) < largest * SHEAR_MIN_RATIO)
+}
+
+/// `2^-126`: the smallest ratio of direction components whose shear is a normal `f32`.
+const SHEAR_MIN_RATIO: f64 = 1.0 / 85_070_591_730_234_615_865_843_651_857_942_052_864.0;
+
+/// Direction components at or above this (or zero) in a direction none of whose components exceeds
+/// [`MODERATE_MAX`] lie at most `2^126` apart ([`shear_not_normal`]), and none is subnormal.
+const PLAIN_MIN: f32 = 1.0 / 4_611_686_018_427_387_904.0;
+
 /// `ray` scaled by `2^-k` and the exponent `e` a hit's `t` must be scaled back by, or `None`
 /// where no exact scaling exists. Origin and direction scale alike where they can and the
 /// direction stays moderate (`e = 0`); where it would overflow, underflow or leave
@@ -147,7 +164,12 @@ fn reciprocal_overflows(d: &[f32; 3]) -> bool {
 /// direction with a component whose reciprocal overflows ([`reciprocal_overflows`]) is scaled up
 /// until its smallest nonzero component is normal, and refused where that would take its largest
 /// past [`MODERATE_MAX`] or its interval cannot follow exactly (so is one scaled with a scene).
+/// A direction whose components lie more than `2^126` apart is refused first
+/// ([`shear_not_normal`]).
 fn scaled(ray: &Ray, k: i32) -> Option<(Ray, i32)> {
+    if shear_not_normal(&ray.dir) {
+        return None;
+    }
     let largest = ray.dir.iter().fold(0.0f32, |m, x| m.max(x.abs()));
     let mixed = largest >= MODERATE_MIN && reciprocal_overflows(&ray.dir);
     if k == 0 && largest <= MODERATE_MAX && !mixed {
@@ -209,7 +231,8 @@ fn box_interval(ray: &Ray, b: &Aabb) -> Option<(f64, f64)> {
 
 /// Whether `ray` surely needs no change in an unscaled scene: every origin component within
 /// `far`, some direction component above `min_dir` ([`min_reliable_dir`]), none above
-/// [`MODERATE_MAX`] and none subnormal. Those bound the exact decision's `reach = scale + max|origin|` by
+/// [`MODERATE_MAX`] and none nonzero below [`PLAIN_MIN`] (none subnormal, none more than `2^126`
+/// below another). Those bound the exact decision's `reach = scale + max|origin|` by
 /// `scale + far` and its `max|d|` from below, so its slack is finite with room to spare. Only comparisons of single components, no horizontal
 /// maximum and no product: a third of what the filter cost before, and it is run over every ray
 /// of a batch (`docs/notes/*-benchmarks-embree-gap.md`, "A cheaper framing filter"). A NaN origin
@@ -220,8 +243,9 @@ fn surely_kept(ray: &Ray, far: f32, min_dir: f32) -> bool {
     let near = |i: usize| ray.origin[i].abs() <= far;
     let sized = |i: usize| ray.dir[i].abs() > min_dir;
     let capped = |i: usize| ray.dir[i].abs() <= MODERATE_MAX;
-    // Zero or normal: a subnormal component may have a reciprocal that overflows.
-    let plain = |i: usize| ray.dir[i].abs() >= f32::MIN_POSITIVE || ray.dir[i] == 0.0;
+    // Zero or at least 2^-62: a subnormal component may have a reciprocal that overflows, and
+    // with the cap, components at most 2^126 apart keep the triangle test's shear normal.
+    let plain = |i: usize| ray.dir[i].abs() >= PLAIN_MIN || ray.dir[i] == 0.0;
     near(0)
         & near(1)
         & near(2)
@@ -416,9 +440,12 @@ mod tests {
                 assert!(SlabRay::with_slack(&ray, scale).slack.is_finite(), "cleared an unreliable ray: {ray:?}");
                 assert!(ray.dir.iter().all(|d| d.abs() <= MODERATE_MAX), "cleared a huge direction: {ray:?}");
                 assert!(!reciprocal_overflows(&ray.dir), "cleared a direction whose reciprocal overflows: {ray:?}");
+                assert!(!shear_not_normal(&ray.dir), "cleared a direction whose shear is not normal: {ray:?}");
             }
         }
-        assert!(cleared > checked / 25 && cleared < checked, "{cleared} of {checked} cleared");
+        // Components drawn from 2^-120 to 2^120: about 2% have all three at 2^-62 or above (or
+        // zero) and at most 2^64, what the filter clears.
+        assert!(cleared > checked / 100 && cleared < checked, "{cleared} of {checked} cleared");
     }
 
     /// A camera ray into a scene at 1e37 (scaled by 2^-125): its unit direction scales exactly
@@ -458,21 +485,32 @@ mod tests {
 
     /// A fuzzed ray along `(5.05e-40, 8.27e-40, -0.25)`: `1 / 5.05e-40` overflows, and the slab
     /// test culled a box whose x plane lay at `2.7e-44`, just off the origin, that the ray enters at
-    /// `t = 5.3e-5`. The filter sends it to the exact decision, which scales the direction by 2^5
-    /// (its smallest component normal) with its interval, or refuses it where the interval cannot
-    /// follow exactly.
+    /// `t = 5.3e-5`. Its components lie more than `2^126` apart, so its shear is subnormal: it is
+    /// refused, as is the ray along `(-0, 7e-45, 2.3e11)` whose shear flushed to 0. A direction
+    /// with such components nearer its largest is scaled until they are normal, with its interval,
+    /// or refused where the interval cannot follow exactly.
     #[test]
     fn subnormal_direction_components_are_scaled_to_normal_or_refused() {
         let ray = Ray { origin: [0.0; 3], tmin: 0.0, dir: [5.050_95e-40, 8.265_2e-40, -0.25], tmax: 137_439_990_000.0 };
-        assert!(reciprocal_overflows(&ray.dir));
+        assert!(reciprocal_overflows(&ray.dir) && shear_not_normal(&ray.dir));
         assert!(!surely_kept(&ray, 48.0, min_reliable_dir(12.0, 48.0)), "the filter clears it");
-        let (r, e) = scaled(&ray, 0).expect("scales exactly");
-        assert_eq!(e, 5);
-        assert_eq!(r.dir, ray.dir.map(|d| d * 32.0));
+        assert_eq!(scaled(&ray, 0), None);
+        let flushed = Ray { tmin: -0.5, dir: [-0.0, 7e-45, 225_830_750_000.0], tmax: 225_831_060_000.0, ..ray };
+        assert!(!surely_kept(&flushed, 48.0, min_reliable_dir(12.0, 48.0)) && scaled(&flushed, 0).is_none());
+        // Components of 1e-19 and 1, all normal: the filter sends them to the decision, which
+        // keeps them (2^63 apart at most).
+        let slight = Ray { dir: [1e-19, 0.0, 1.0], ..ray };
+        assert!(!surely_kept(&slight, 48.0, min_reliable_dir(12.0, 48.0)));
+        assert_eq!(scaled(&slight, 0), Some((slight, 0)));
+        let near_axis = Ray { dir: [5.050_95e-40, 8.265_2e-40, -2.5e-10], ..ray };
+        assert!(reciprocal_overflows(&near_axis.dir) && !shear_not_normal(&near_axis.dir));
+        let (r, e) = scaled(&near_axis, 0).expect("scales exactly");
+        let factor = r.dir[2] / near_axis.dir[2];
+        assert_eq!(r.dir, near_axis.dir.map(|d| d * factor), "scaled by one power of two");
         assert!(r.dir.iter().all(|d| d.abs() >= f32::MIN_POSITIVE) && !reciprocal_overflows(&r.dir));
-        assert_eq!((r.origin, r.tmin, r.tmax), (ray.origin, 0.0, ray.tmax / 32.0));
-        // An interval end that loses bits when divided by 32 (the smallest subnormal): refused.
-        let inexact = Ray { tmin: f32::from_bits(1), ..ray };
+        assert_eq!((r.origin, r.tmin, r.tmax, factor), (ray.origin, 0.0, ray.tmax / factor, 2f32.powi(e)));
+        // An interval end that loses bits when scaled (the smallest subnormal): refused.
+        let inexact = Ray { tmin: f32::from_bits(1), ..near_axis };
         assert_eq!(scaled(&inexact, 0), None);
         // Components more than 2^190 apart cannot all be normal with the largest moderate.
         let apart = Ray { dir: [1e-44, 0.0, 1e19], ..ray };
