@@ -34,7 +34,8 @@ fn chunk_rays(method: Method) -> usize {
 #[derive(Debug, Default)]
 pub struct CpuBackend {
     pool: Option<rayon::ThreadPool>,
-    sort_buffers: SortScratch,
+    /// The buffers of sorted traces ([`crate::trace_order`]), kept from one batch to the next.
+    pub(crate) sort_buffers: SortScratch,
 }
 
 /// A scene as the CPU backend holds it: shared, read in place.
@@ -92,7 +93,7 @@ impl Trace for CpuBackend {
     fn trace(&self, scene: &CpuScene, rays: &[Ray], opts: &TraceOptions, hits: &mut [Hit]) -> Result<Report, Error> {
         // The stream method sorts the rays its own way (Garanzha & Loop's ray hashing).
         if opts.order == TraceOrder::Sorted && !matches!(opts.method, Method::Stream(_)) {
-            return crate::trace_order::trace_sorted(self, &self.sort_buffers, scene, rays, opts, hits);
+            return crate::trace_order::trace_sorted(self, scene, rays, opts, hits);
         }
         if let Some(report) = self.trace_in_frame(scene, rays, opts, hits, Framing::Check)? {
             return Ok(report);

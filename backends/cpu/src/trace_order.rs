@@ -41,10 +41,10 @@ struct SortBuffers {
 #[derive(Debug, Default)]
 pub(crate) struct SortScratch(Mutex<SortBuffers>);
 
-/// Traces `rays` in the order of their keys into `hits`, in the caller's order.
+/// Traces `rays` in the order of their keys into `hits`, in the caller's order, in `backend`'s
+/// sort buffers.
 pub(crate) fn trace_sorted(
     backend: &CpuBackend,
-    scratch: &SortScratch,
     scene: &CpuScene,
     rays: &[Ray],
     opts: &TraceOptions,
@@ -53,7 +53,7 @@ pub(crate) fn trace_sorted(
     check_buffers(rays, hits)?;
     let start = Instant::now();
     let mut fresh = SortBuffers::default();
-    let mut held = scratch.0.try_lock();
+    let mut held = backend.sort_buffers.0.try_lock();
     let buffers = match held.as_deref_mut() {
         Ok(b) => b,
         Err(_) => &mut fresh,
