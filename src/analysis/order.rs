@@ -17,7 +17,7 @@ use raytrail_cpu::{CpuBackend, CpuScene};
 pub const SORTED_WALK: Method = Method::Wide(WideMethod::BVH8_SAH_PACKET);
 
 /// The walk a sample is timed with to tell whether its batch is slow enough to sort.
-const PROBE_WALK: Method = Method::Wide(WideMethod::BVH8_SAH);
+pub const PROBE_WALK: Method = Method::Wide(WideMethod::BVH8_SAH);
 
 /// Seconds per ray and thread, on the sample traced as given by [`PROBE_WALK`], from which `auto`
 /// sorts a batch: sorting costs about 25 ns a ray on two threads and gains 10-40% of the trace,
