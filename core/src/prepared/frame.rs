@@ -160,19 +160,19 @@ const PLAIN_MIN: f32 = 1.0 / 4_611_686_018_427_387_904.0;
 /// scene (`k = 0`) only a direction above [`MODERATE_MAX`] is scaled so: its distances are so
 /// small that the triangle test's products of edge functions and depths underflow (a fuzzed
 /// direction of `1.3e36` hit triangles behind its origin at `t = 0`). Directions below the range
-/// stay as given there, and the reliability bound refuses those it must; but a moderate
-/// direction with a component whose reciprocal overflows ([`reciprocal_overflows`]) is scaled up
-/// until its smallest nonzero component is normal, and refused where that would take its largest
-/// past [`MODERATE_MAX`] or its interval cannot follow exactly (so is one scaled with a scene).
-/// A direction whose components lie more than `2^126` apart is refused first
-/// ([`shear_not_normal`]).
+/// stay as given there, and the reliability bound refuses those it must; but a direction of any
+/// size with a component whose reciprocal overflows ([`reciprocal_overflows`]) is scaled as one
+/// below the range would be in a scaled scene, and refused where that would take its largest past
+/// [`MODERATE_MAX`] or its interval cannot follow exactly (so is one scaled with a scene): a fuzzed
+/// ray along `(2.7e-43, -9.8e-25, -9.8e-25)`, its largest component below the range, kept its
+/// infinite `1 / d_x` and missed a box whose x plane was `0`, just beside its origin. A direction
+/// whose components lie more than `2^126` apart is refused first ([`shear_not_normal`]).
 fn scaled(ray: &Ray, k: i32) -> Option<(Ray, i32)> {
     if shear_not_normal(&ray.dir) {
         return None;
     }
     let largest = ray.dir.iter().fold(0.0f32, |m, x| m.max(x.abs()));
-    let mixed = largest >= MODERATE_MIN && reciprocal_overflows(&ray.dir);
-    if k == 0 && largest <= MODERATE_MAX && !mixed {
+    if k == 0 && largest <= MODERATE_MAX && !reciprocal_overflows(&ray.dir) {
         return Some((*ray, 0));
     }
     let s = |v: [f32; 3], k: i32| -> Option<[f32; 3]> {
@@ -336,7 +336,12 @@ impl Frame {
         } else {
             (Fix::Keep, r)
         };
-        if fix != Fix::Miss && !SlabRay::with_slack(&r, scale).slack.is_finite() {
+        // A direction scaled up in an unscaled scene (`exp > 0`: hits come back multiplied by
+        // `2^exp`) keeps the distances of the ray as given, so the bound applies to that ray too:
+        // a direction of `2e-44` scaled to unit size traced reliably, and its hit at `t = 5.6e44`
+        // came back infinite.
+        let unreliable = |r: &Ray| !SlabRay::with_slack(r, scale).slack.is_finite();
+        if fix != Fix::Miss && (unreliable(&r) || (k == 0 && exp > 0 && unreliable(ray))) {
             return (Fix::Refused, NOTHING);
         }
         (fix, r)
@@ -512,6 +517,15 @@ mod tests {
         // An interval end that loses bits when scaled (the smallest subnormal): refused.
         let inexact = Ray { tmin: f32::from_bits(1), ..near_axis };
         assert_eq!(scaled(&inexact, 0), None);
+        // A direction below the moderate range with a subnormal component (a fuzzed ray that
+        // missed a box whose x plane lay at 0, beside its origin at x = -2.9e-41): scaled so
+        // that the largest is in [0.5, 1) and every component normal.
+        let tiny =
+            Ray { origin: [-2.8699e-41, -2.68e-43, -0.5], dir: [2.68e-43, -9.758_146e-25, -9.796_413e-25], ..ray };
+        assert!(reciprocal_overflows(&tiny.dir) && !shear_not_normal(&tiny.dir));
+        let (r, e) = scaled(&tiny, 0).expect("scales exactly");
+        assert!((0.5..1.0).contains(&r.dir[2].abs()) && !reciprocal_overflows(&r.dir), "{r:?}");
+        assert_eq!((r.origin, r.tmax * 2f32.powi(e)), (tiny.origin, tiny.tmax));
         // Components more than 2^190 apart cannot all be normal with the largest moderate.
         let apart = Ray { dir: [1e-44, 0.0, 1e19], ..ray };
         assert_eq!(scaled(&apart, 0), None);
