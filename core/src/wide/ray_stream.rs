@@ -93,21 +93,27 @@ struct StreamScratch<const W: usize, T: TriangleTest, O> {
     t_enter: Vec<[f32; W]>,
 }
 
+/// List entries reserved per ray of a stream, up front: the lists of the postponed children grow
+/// past it where they must.
+const ITEMS_PER_RAY: usize = 8;
+
 impl<const W: usize, T: TriangleTest, O> StreamScratch<W, T, O> {
-    /// Empty buffers.
-    fn new() -> Self {
+    /// Buffers with room for streams of `rays` rays, each allocated once. Grown from empty, they
+    /// were reallocated and copied a dozen times in every stream, and each parallel task (one
+    /// stream) makes its own scratch.
+    fn with_capacity(rays: usize) -> Self {
         Self {
-            rays: Vec::new(),
-            tri: Vec::new(),
-            q: Vec::new(),
-            obs: Vec::new(),
-            place: Vec::new(),
-            active: Vec::new(),
-            items: Vec::new(),
-            stack: Vec::new(),
-            live: Vec::new(),
-            masks: Vec::new(),
-            t_enter: Vec::new(),
+            rays: Vec::with_capacity(rays),
+            tri: Vec::with_capacity(rays),
+            q: Vec::with_capacity(rays),
+            obs: Vec::with_capacity(rays),
+            place: Vec::with_capacity(rays),
+            active: Vec::with_capacity(rays),
+            items: Vec::with_capacity(rays * ITEMS_PER_RAY),
+            stack: Vec::with_capacity(WIDE_STACK),
+            live: Vec::with_capacity(rays + 1),
+            masks: Vec::with_capacity(rays),
+            t_enter: Vec::with_capacity(rays),
         }
     }
 }
@@ -132,7 +138,7 @@ pub fn trace_wide_streams<
     mut done: impl FnMut(usize, O),
 ) {
     let n = rays.len().min(hits.len());
-    let mut s = StreamScratch::<W, T, O>::new();
+    let mut s = StreamScratch::<W, T, O>::with_capacity(n.min(STREAM_RAYS));
     for (c, chunk) in rays[..n].chunks(STREAM_RAYS).enumerate() {
         let base = c * STREAM_RAYS;
         trace_wide_stream::<W, M, T, K, O>(mem, root, chunk, query, &mut s);
