@@ -261,7 +261,10 @@ fn locate_bad_reference(data: &[u8]) -> Option<(usize, String)> {
                         let resolved = if x < 0 { defined[k] + x } else { x - 1 };
                         // A texcoord or normal index of 0 means "none" to tobj; a vertex one is invalid.
                         let missing_ok = k > 0 && x == 0;
-                        let checked = k == 0 || defined[k] > 0;
+                        // tobj ignores texcoord and normal references while none are defined, but
+                        // it resolves a relative one at the face and uses it once the file has
+                        // defined some: before any, `-4` resolves below zero and overflows there.
+                        let checked = k == 0 || defined[k] > 0 || x < 0;
                         if checked && !missing_ok && !(0..defined[k]).contains(&resolved) {
                             let (one, many) = KINDS[k];
                             let why =
@@ -477,7 +480,13 @@ f 1/1/1 2/1/  -1 \nf 1/1/1 2/1/1 3/1/-100 0\nvn -2 -3 0 0 1\nf 1/1\nf 1/v0000 0\
         // The first campaign's crash: a relative normal ending in a vertical tab, a word separator
         // to tobj but not to `u8::is_ascii_whitespace`, so the pre-check saw no number.
         let tab = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//-10\x0b\n";
-        for (text, line) in [(fuzzed, 13), ("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/-9 2/1 3/1\n", 5), (tab, 5)] {
+        // The third campaign's: a relative texcoord before any texcoord is defined (`?vt` is not
+        // one), with one defined further on, where tobj resolves the face's `-4`.
+        let before =
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n?vt 0 0\nf 1/1/1 2/1/1 3/1/1 4/-4 -3 -2\nvt 0 0\nf 1/1 2/1 3/1\n";
+        for (text, line) in
+            [(fuzzed, 13), ("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/-9 2/1 3/1\n", 5), (tab, 5), (before, 6)]
+        {
             let e = err(text);
             assert!(e.starts_with(&format!("t.obj:{line}: face refers to ")), "{e}");
             assert!(!e.contains("panicked"), "{e}");
