@@ -526,6 +526,20 @@ mod tests {
         let (r, e) = scaled(&tiny, 0).expect("scales exactly");
         assert!((0.5..1.0).contains(&r.dir[2].abs()) && !reciprocal_overflows(&r.dir), "{r:?}");
         assert_eq!((r.origin, r.tmax * 2f32.powi(e)), (tiny.origin, tiny.tmax));
+        // Scaled up, a direction keeps the distances of the ray as given, so the reliability bound
+        // judges that ray: one of nothing but subnormals (the instanced check's adversarial ray,
+        // whose hit lies at `t = 5.6e44`, past the `f32` range) is refused, where the fuzzed
+        // ray, reliable as given, is traced scaled.
+        let frame = Frame {
+            scale: 30.0,
+            grown: Aabb::new(glam::Vec3::splat(-34.0), glam::Vec3::splat(34.0)),
+            far: 120.0,
+            min_dir: min_reliable_dir(30.0, 120.0),
+            k: 0,
+        };
+        let subnormal = Ray { origin: [15.629_128, 25.815_441, -9.516_532], dir: [-2.1e-44, -3.8e-44, 1.7e-44], ..ray };
+        assert_eq!(frame.decide(&subnormal).0, Fix::Refused);
+        assert!(matches!(frame.decide(&tiny).0, Fix::Moved(t0, e) if t0 == 0.0 && e > 0), "{:?}", frame.decide(&tiny));
         // Components more than 2^190 apart cannot all be normal with the largest moderate.
         let apart = Ray { dir: [1e-44, 0.0, 1e19], ..ray };
         assert_eq!(scaled(&apart, 0), None);
