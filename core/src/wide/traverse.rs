@@ -4,7 +4,8 @@
 
 use super::kernel::{ChildHits, ChildKernel};
 use super::memory::WideMemory;
-use super::node::WideChild;
+use super::node::{WideChild, EMPTY_CHILD};
+use crate::bvh2::NodeRef;
 use crate::intersect::{BlockHits, NoPair, RayContext, TriangleHit, TriangleTest, BLOCK};
 use crate::method::Query;
 use crate::observe::{Backtrack, Observer};
@@ -63,7 +64,7 @@ impl<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel>
         let after_hit = match current {
             WideChild::Node(index) => match expand::<W, M, T, K>(&mut self.stack, &mut self.len, mem, index, ctx, q) {
                 Expanded::Next(c) => {
-                    self.current = Some(c);
+                    self.current = c.decode();
                     return Step::Continue;
                 }
                 Expanded::EmptyFirst => {
@@ -80,7 +81,7 @@ impl<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKernel>
                 hit
             }
         };
-        self.current = pop(&self.stack, &mut self.len, ctx, q, obs);
+        self.current = pop(&self.stack, &mut self.len, ctx, q, obs).and_then(SlotWords::decode);
         match self.current {
             None => Step::Done,
             Some(_) if after_hit => Step::AfterHit,
@@ -109,7 +110,7 @@ impl<const W: usize, K: ChildKernel> WideState<W, K> {
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn run_from<M: WideMemory<W> + ?Sized, T: TriangleTest, O: Observer>(
         &mut self,
-        mut current: WideChild,
+        current: WideChild,
         mut len: usize,
         mem: &M,
         ctx: &WideRayContext<T>,
@@ -118,10 +119,11 @@ impl<const W: usize, K: ChildKernel> WideState<W, K> {
         max_steps: u32,
     ) {
         let mut budget = max_steps;
+        let mut at = SlotWords::of(current);
         loop {
-            obs.node(current.node_ref());
-            let next = match current {
-                WideChild::Node(index) => match expand::<W, M, T, K>(&mut self.stack, &mut len, mem, index, ctx, q) {
+            obs.node(at.node_ref());
+            let next = if at.count == 0 {
+                match expand::<W, M, T, K>(&mut self.stack, &mut len, mem, at.child, ctx, q) {
                     Expanded::Next(c) => Some(c),
                     // `step` leaves no node to visit: its next call ends the ray.
                     Expanded::EmptyFirst => {
@@ -129,23 +131,22 @@ impl<const W: usize, K: ChildKernel> WideState<W, K> {
                         return;
                     }
                     Expanded::NoneHit => pop(&self.stack, &mut len, ctx, q, obs),
-                },
-                WideChild::Leaf { first, count } => {
-                    leaf::<W, M, T, K, O>(mem, first, count, ctx, q, obs);
-                    if q.is_answered() {
-                        self.current = None;
-                        return;
-                    }
-                    pop(&self.stack, &mut len, ctx, q, obs)
                 }
+            } else {
+                leaf::<W, M, T, K, O>(mem, at.child, at.count, ctx, q, obs);
+                if q.is_answered() {
+                    self.current = None;
+                    return;
+                }
+                pop(&self.stack, &mut len, ctx, q, obs)
             };
             match next {
                 Some(c) if budget > 0 => {
                     budget -= 1;
-                    current = c;
+                    at = c;
                 }
                 _ => {
-                    (self.current, self.len) = (next, len);
+                    (self.current, self.len) = (next.and_then(SlotWords::decode), len);
                     return;
                 }
             }
@@ -167,10 +168,51 @@ struct Postponed {
     t_enter: f32,
 }
 
+/// A child that is not an empty slot, as its slot's two words (see [`WideNode`]'s layout): an
+/// internal node where `count` is 0, a leaf otherwise. The single-ray loop carries this form and
+/// tells node from leaf by `count` alone; building a [`WideChild`] at every visit and matching it
+/// again took a select, a spill and a second test per visit
+/// (`docs/notes/*-single-ray-selects.md`).
+///
+/// [`WideNode`]: super::node::WideNode
+#[derive(Clone, Copy, Debug)]
+struct SlotWords {
+    child: u32,
+    count: u32,
+}
+
+impl SlotWords {
+    /// The words of `c`.
+    #[inline(always)]
+    fn of(c: WideChild) -> Self {
+        match c {
+            WideChild::Node(child) => Self { child, count: 0 },
+            WideChild::Leaf { first, count } => Self { child: first, count },
+        }
+    }
+
+    /// The child these words refer to (`None` only for an empty slot's words, which the walk
+    /// never carries).
+    #[inline(always)]
+    fn decode(self) -> Option<WideChild> {
+        WideChild::from_words(self.child, self.count)
+    }
+
+    /// [`WideChild::node_ref`] of the child.
+    #[inline(always)]
+    fn node_ref(self) -> NodeRef {
+        if self.count == 0 {
+            NodeRef::internal(self.child)
+        } else {
+            NodeRef::leaf(self.child)
+        }
+    }
+}
+
 /// What testing an internal node's children left to do.
 enum Expanded {
     /// Visit this child next (the others hit are on the stack).
-    Next(WideChild),
+    Next(SlotWords),
     /// The first child in order is an empty slot (never, on an intact tree): nothing to visit.
     EmptyFirst,
     /// No child is hit: go back to the stack.
@@ -197,22 +239,56 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
     }
     // As early as the hit children are known, so that their loads overlap the ordering below.
     mem.prefetch_hit_children(&node, hits.mask);
-    let mut order = [0u32; W];
-    let n = visiting_order::<W, K>(&hits, q.any, &mut order);
-    for k in (1..n).rev() {
-        let slot = order[k] as usize % W;
+    let rest = hits.mask & (hits.mask - 1);
+    let nearest = if rest & rest.wrapping_sub(1) == 0 {
+        // One or two children hit, most nodes on scattered rays: the pair ordered without the
+        // order array or a branch on which of the two counts it is (that branch missed 2.4 times
+        // a ray on Sponza's shuffled diffuse rays, whose rays visit about 8 internal nodes). The
+        // order is `visiting_order`'s: the nearer first, a tie (or an unsorted any-hit query) in
+        // slot order.
+        let first = hits.mask.trailing_zeros() as usize % W;
+        let second = if rest != 0 { rest.trailing_zeros() as usize % W } else { first };
+        let (near, far) = if !q.any || K::SORTED_ANY {
+            // The swap as arithmetic on the slots: written as an `if`, it compiled to a branch
+            // that missed 1.1 times a ray.
+            let swap = usize::from(hits.t_enter[second] < hits.t_enter[first]);
+            let near = first ^ ((first ^ second) & swap.wrapping_neg());
+            (near, near ^ first ^ second)
+        } else {
+            // Slot order: the next child follows from the hit mask alone, not from the entry
+            // distances (a longer chain of dependent operations before the next node's loads).
+            (first, second)
+        };
+        // The farther one is written either way and counted only where there are two: an entry
+        // past `len` is never read, and the count needs no branch.
         if *len < WIDE_STACK {
             stack[*len] = MaybeUninit::new(Postponed {
-                child: node.child[slot],
-                count: node.count[slot],
-                t_enter: hits.t_enter[slot],
+                child: node.child[far],
+                count: node.count[far],
+                t_enter: hits.t_enter[far],
             });
-            *len += 1;
+            *len += usize::from(rest != 0);
         }
-    }
-    match node.child_ref(order[0] as usize) {
-        Some(c) => Expanded::Next(c),
-        None => Expanded::EmptyFirst,
+        near
+    } else {
+        let mut order = [0u32; W];
+        let n = visiting_order::<W, K>(&hits, q.any, &mut order);
+        for k in (1..n).rev() {
+            let slot = order[k] as usize % W;
+            if *len < WIDE_STACK {
+                stack[*len] = MaybeUninit::new(Postponed {
+                    child: node.child[slot],
+                    count: node.count[slot],
+                    t_enter: hits.t_enter[slot],
+                });
+                *len += 1;
+            }
+        }
+        order[0] as usize % W
+    };
+    match node.child[nearest] {
+        EMPTY_CHILD => Expanded::EmptyFirst,
+        child => Expanded::Next(SlotWords { child, count: node.count[nearest] }),
     }
 }
 
@@ -249,16 +325,18 @@ fn pop<O: Observer>(
     ctx: &WideRayContext<impl TriangleTest>,
     q: &QueryState,
     obs: &mut O,
-) -> Option<WideChild> {
+) -> Option<SlotWords> {
     while *len > 0 {
         *len -= 1;
         // SAFETY: entries below `len` were written by a push before `len` passed them (`len`
         // only grows by a push that writes the entry it passes), and `len` was above this one.
         let e = unsafe { stack[*len].assume_init() };
-        let Some(child) = WideChild::from_words(e.child, e.count) else { continue };
+        if e.child == EMPTY_CHILD {
+            continue;
+        }
         obs.backtrack(0, Backtrack::StackPop);
         if e.t_enter <= q.limit() + ctx.t_slack {
-            return Some(child);
+            return Some(SlotWords { child: e.child, count: e.count });
         }
     }
     None
@@ -360,6 +438,10 @@ pub fn trace_wide_batch<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTe
 ) {
     let mut state = WideState::<W, K>::new(root.root);
     for_each_ray::<T, NoPair>(rays, hits, root.scene_scale, query, |ctx, q| {
+        // The triangle test's constants made here rather than at the first leaf: nearly every
+        // ray reaches a leaf, and the check at each leaf whether they were made yet missed 0.6
+        // times a ray on shuffled diffuse rays (LLVM had hoisted most of the work here anyway).
+        ctx.tri();
         state.run_from(root.root, 0, mem, ctx, q, obs, root.max_steps);
     });
 }

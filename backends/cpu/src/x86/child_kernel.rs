@@ -3,13 +3,13 @@
 //! compile with AVX2's three-operand encoding inside the walks that use it.
 
 use raytrail_core::intersect::{SlabRay, FAR_PAD};
-use raytrail_core::wide::{sort_keys, ChildHits, ChildKernel, FastKernel, StreamRay, WideNode};
+use raytrail_core::wide::{ChildHits, ChildKernel, FastKernel, StreamRay, WideNode};
 use std::arch::x86_64::{
-    _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_ps, _mm256_castps_si256,
-    _mm256_cmp_ps, _mm256_cmpgt_epi32, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps,
-    _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps,
-    _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256, _mm256_sub_epi32, _mm256_sub_ps, _CMP_EQ_OQ,
-    _CMP_LE_OQ, _CMP_LT_OQ,
+    _mm256_add_ps, _mm256_and_ps, _mm256_and_si256, _mm256_andnot_ps, _mm256_blendv_epi8, _mm256_blendv_ps,
+    _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_cmpgt_epi32, _mm256_loadu_ps,
+    _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_or_si256,
+    _mm256_set1_epi32, _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_si256, _mm256_storeu_ps, _mm256_storeu_si256,
+    _mm256_sub_epi32, _mm256_sub_ps, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
 };
 
 /// The fast kernel with 8-wide nodes tested in one AVX operation per plane and ordered by
@@ -71,19 +71,27 @@ impl ChildKernel for AvxKernel {
 unsafe fn test_avx<const W: usize>(node: &WideNode<W>, s: &SlabRay, tmin: f32, tmax: f32) -> ChildHits<W> {
     let mut out = ChildHits { t_enter: [f32::INFINITY; W], mask: 0 };
     let (o, inv) = (s.origin.to_array(), s.inv_dir.to_array());
+    // The node's six plane arrays in `WideNode`'s order (`lo` x, y, z, then `hi` x, y, z), `W`
+    // floats each, read through one pointer to the whole node.
+    let planes = (node as *const WideNode<W>).cast::<f32>();
     let mut lane = 0;
     while lane + 8 <= W {
         let splat = |x: f32| _mm256_set1_ps(x);
         let (mut t_enter, mut t_exit) = (splat(tmin), splat(tmax));
         for a in 0..3 {
             // Planes picked by the direction's sign (`negative`, as the reference picks them) as
-            // an address rather than by a blend of both: the loads start the chain, and per-ray
-            // constant signs keep the choice predicted. 1.02 on the kitchen's inside camera and
-            // diffuse rays (`docs/notes/*-benchmarks-leaf-blocks.md`, "Packets' box tests by ray").
-            let (np, fp) = if s.negative[a] { (&node.hi[a], &node.lo[a]) } else { (&node.lo[a], &node.hi[a]) };
-            // SAFETY: eight floats inside arrays of `W`, from `lane <= W - 8`.
-            let (near, far) =
-                unsafe { (_mm256_loadu_ps(np.as_ptr().add(lane)), _mm256_loadu_ps(fp.as_ptr().add(lane))) };
+            // an address rather than by a blend of both: the loads start the chain. 1.02 on the
+            // kitchen's inside camera and diffuse rays (`docs/notes/*-benchmarks-leaf-blocks.md`,
+            // "Packets' box tests by ray"). The address is computed from the sign, not branched
+            // on: a branch on the x sign missed 2.5 times a ray on shuffled diffuse rays, whose
+            // signs change from ray to ray (`docs/notes/*-single-ray-selects.md`).
+            let neg = usize::from(s.negative[a]);
+            let (near_plane, far_plane) = (a + 3 * neg, a + 3 - 3 * neg);
+            // SAFETY: plane arrays 0..6 of `W` floats lie inside the node (`repr(C)`, no
+            // padding), eight floats from `lane <= W - 8` inside each.
+            let (near, far) = unsafe {
+                (_mm256_loadu_ps(planes.add(near_plane * W + lane)), _mm256_loadu_ps(planes.add(far_plane * W + lane)))
+            };
             let (oa, ia) = (splat(o[a]), splat(inv[a]));
             let tn = _mm256_mul_ps(_mm256_sub_ps(near, oa), ia);
             let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, oa), ia), splat(FAR_PAD));
@@ -151,11 +159,11 @@ unsafe fn stream_node_avx<const W: usize>(
 }
 
 /// Three or more hit children of an 8-wide node ordered without a branch: each child's rank is
-/// the number of children before it in the order of [`sort_keys`] (entry distance, then slot; a
-/// missed child ranks after every hit one), counted by eight
-/// vector comparisons, and the child is written at its rank. The order is the sorting network's
-/// and the reference's insertion sort's, since all three sort by the same total order; the
-/// network compiled to two branches per compare-and-swap here.
+/// the number of children before it in the order of
+/// [`sort_keys`](raytrail_core::wide::sort_keys) (entry distance, then slot; a missed child ranks
+/// after every hit one), counted by eight vector comparisons, and the child is written at its
+/// rank. The order is the sorting network's and the reference's insertion sort's, since all three
+/// sort by the same total order; the network compiled to two branches per compare-and-swap here.
 ///
 /// # Safety
 /// The processor must run the AVX2 path ([`crate::x86::available`]).
@@ -166,11 +174,24 @@ unsafe fn order_by_rank<const W: usize>(hits: &ChildHits<W>, order: &mut [u32; W
         // The loads below read eight lanes.
         return FastKernel::order(hits, order);
     }
-    // The sort keys every kernel orders by: slots count as integers below 16, so the signed
-    // comparison of their bits is theirs.
-    let (k, s) = sort_keys(hits);
-    let keys = _mm256_loadu_ps(k.as_ptr());
-    let slots = _mm256_loadu_si256(s.as_ptr().cast());
+    // The sort keys every kernel orders by, `sort_keys`'s made by blends on the hit lanes: its
+    // selects compiled to a branch per child, which missed 0.8 times a ray on shuffled diffuse
+    // rays. Slots count as integers below 16, so the signed comparison of their bits is theirs.
+    let bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    let hit = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(hits.mask as i32), bit), bit);
+    let keys = _mm256_blendv_ps(
+        _mm256_set1_ps(f32::INFINITY),
+        _mm256_loadu_ps(hits.t_enter.as_ptr()),
+        _mm256_castsi256_ps(hit),
+    );
+    let slots = _mm256_blendv_epi8(
+        _mm256_setr_epi32(8, 9, 10, 11, 12, 13, 14, 15),
+        _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+        hit,
+    );
+    let (mut k, mut s) = ([0f32; 8], [0u32; 8]);
+    _mm256_storeu_ps(k.as_mut_ptr(), keys);
+    _mm256_storeu_si256(s.as_mut_ptr().cast(), slots);
     let mut rank = _mm256_setzero_si256();
     for j in 0..8 {
         let (kj, sj) = (_mm256_set1_ps(k[j]), _mm256_set1_epi32(s[j] as i32));
