@@ -76,7 +76,7 @@ fn run_equals_drive<Mem: ?Sized, Ctx, S: Machine<Mem, Ctx>>(
     drive(&mut fresh(), mem, ctx, &mut q_step, &mut e_step, max_steps);
     fresh().run(mem, ctx, &mut q_run, &mut e_run, max_steps);
     let bits = |h: raytrail_core::Hit| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits());
-    assert_eq!(bits(q_run.hit), bits(q_step.hit), "{what:?}");
+    assert_eq!(bits(q_run.hit()), bits(q_step.hit()), "{what:?}");
     assert_eq!(e_run, e_step, "{what:?}");
     e_run.counters.internal_nodes + e_run.counters.leaves
 }

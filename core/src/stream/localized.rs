@@ -134,7 +134,7 @@ pub fn intersect_packet<T: TriangleTest, K: ChildKernel, O: Observer>(
                 }
             }
         }
-        *hit = q.hit;
+        *hit = q.hit();
     }
 }
 

@@ -41,7 +41,7 @@ pub fn for_each_ray<T: TriangleTest, B: BoxConstants>(
         *hit = match begin::<T, B>(ray, scene_scale, query) {
             Some((ctx, mut q)) => {
                 trace(&ctx, &mut q);
-                q.hit
+                q.hit()
             }
             None => Hit::MISS,
         };

@@ -289,7 +289,7 @@ impl<const N: usize> PacketLanes<N> {
     /// Keeps `q` as lane `i`'s answer so far (and its culling distance).
     #[inline(always)]
     pub fn record(&mut self, i: usize, q: &QueryState) {
-        (self.hit[i], self.limit[i]) = (q.hit, q.limit());
+        (self.hit[i], self.limit[i]) = (q.hit(), q.limit());
     }
 
     /// Whether lane `i`'s query is answered (an any-hit ray that found a hit).

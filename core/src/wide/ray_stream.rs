@@ -147,7 +147,7 @@ pub fn trace_wide_streams<
         let mut traced = 0;
         for i in 0..chunk.len() {
             if s.place.get(traced).is_some_and(|&p| p as usize == i) {
-                hits[base + i] = s.q[traced].hit;
+                hits[base + i] = s.q[traced].hit();
                 done(base + i, core::mem::take(&mut s.obs[traced]));
                 traced += 1;
             } else {

@@ -460,7 +460,7 @@ fn run_warp<S: Stepper>(
         }
     }
     for lane in lanes {
-        out.hits[lane.ray] = lane.q.hit;
+        out.hits[lane.ray] = lane.q.hit();
         out.report.counters.add(&lane.obs.counters);
         out.per_ray[lane.ray] = lane.obs.counters;
         if let Some(n) = lane.obs.nodes {

@@ -38,5 +38,5 @@ pub fn kd_leaf<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
             }
         }
     }
-    q.hit.is_hit() && q.hit.t + ctx.t_slack < t_max
+    q.hit().is_hit() && q.hit().t + ctx.t_slack < t_max
 }

@@ -146,6 +146,6 @@ pub fn trace_kd_packet<const W: usize, M: KdMemory + ?Sized, T: TriangleTest, O:
         }
     }
     for i in 0..n {
-        hits[i] = q[i].hit;
+        hits[i] = q[i].hit();
     }
 }

@@ -91,5 +91,5 @@ pub fn trace_kd_ray<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
         )
         .run(mem, &ctx, &mut q, obs, root.max_steps),
     }
-    q.hit
+    q.hit()
 }
