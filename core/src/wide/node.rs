@@ -58,10 +58,7 @@ impl<const W: usize> WideNode<W> {
             self.lo[a][i] = lo[a];
             self.hi[a][i] = hi[a];
         }
-        (self.child[i], self.count[i]) = match child {
-            WideChild::Node(n) => (n, 0),
-            WideChild::Leaf { first, count } => (first, count),
-        };
+        (self.child[i], self.count[i]) = child.words();
     }
 
     /// What child slot `i` refers to, or `None` for an empty slot (or a slot past `W`).
@@ -94,6 +91,16 @@ impl WideChild {
             (EMPTY_CHILD, _) => None,
             (n, 0) => Some(WideChild::Node(n)),
             (first, count) => Some(WideChild::Leaf { first, count }),
+        }
+    }
+
+    /// The slot words (`child`, `count`) that hold this child: [`WideChild::from_words`]'s
+    /// inverse.
+    #[inline(always)]
+    pub fn words(self) -> (u32, u32) {
+        match self {
+            WideChild::Node(n) => (n, 0),
+            WideChild::Leaf { first, count } => (first, count),
         }
     }
 

@@ -4,7 +4,7 @@
 
 use super::kernel::{ChildHits, ChildKernel};
 use super::memory::WideMemory;
-use super::node::{WideChild, EMPTY_CHILD};
+use super::node::{WideChild, WideNode, EMPTY_CHILD};
 use crate::bvh2::NodeRef;
 use crate::intersect::{BlockHits, NoPair, RayContext, TriangleHit, TriangleTest, BLOCK};
 use crate::method::Query;
@@ -163,18 +163,15 @@ impl<const W: usize, K: ChildKernel> WideState<W, K> {
 /// are those of never pushing it.
 #[derive(Clone, Copy, Debug)]
 struct Postponed {
-    child: u32,
-    count: u32,
+    slot: SlotWords,
     t_enter: f32,
 }
 
-/// A child that is not an empty slot, as its slot's two words (see [`WideNode`]'s layout): an
-/// internal node where `count` is 0, a leaf otherwise. The single-ray loop carries this form and
-/// tells node from leaf by `count` alone; building a [`WideChild`] at every visit and matching it
-/// again took a select, a spill and a second test per visit
-/// (`docs/notes/*-single-ray-selects.md`).
-///
-/// [`WideNode`]: super::node::WideNode
+/// A child slot's two words (see [`WideNode`]'s layout): an internal node where `count` is 0, a
+/// leaf otherwise, an empty slot where `child` is [`EMPTY_CHILD`] (stacked, never visited: the
+/// pop drops it). The single-ray loop carries this form and tells node from leaf by `count`
+/// alone; building a [`WideChild`] at every visit and matching it again took a select, a spill and
+/// a second test per visit (`docs/notes/*-single-ray-selects.md`).
 #[derive(Clone, Copy, Debug)]
 struct SlotWords {
     child: u32,
@@ -185,10 +182,14 @@ impl SlotWords {
     /// The words of `c`.
     #[inline(always)]
     fn of(c: WideChild) -> Self {
-        match c {
-            WideChild::Node(child) => Self { child, count: 0 },
-            WideChild::Leaf { first, count } => Self { child: first, count },
-        }
+        let (child, count) = c.words();
+        Self { child, count }
+    }
+
+    /// The words of `node`'s child slot `slot` (an empty slot's too).
+    #[inline(always)]
+    fn at<const W: usize>(node: &WideNode<W>, slot: usize) -> Self {
+        Self { child: node.child[slot], count: node.count[slot] }
     }
 
     /// The child these words refer to (`None` only for an empty slot's words, which the walk
@@ -262,11 +263,7 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
         // The farther one is written either way and counted only where there are two: an entry
         // past `len` is never read, and the count needs no branch.
         if *len < WIDE_STACK {
-            stack[*len] = MaybeUninit::new(Postponed {
-                child: node.child[far],
-                count: node.count[far],
-                t_enter: hits.t_enter[far],
-            });
+            stack[*len] = MaybeUninit::new(Postponed { slot: SlotWords::at(&node, far), t_enter: hits.t_enter[far] });
             *len += usize::from(rest != 0);
         }
         near
@@ -276,11 +273,8 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
         for k in (1..n).rev() {
             let slot = order[k] as usize % W;
             if *len < WIDE_STACK {
-                stack[*len] = MaybeUninit::new(Postponed {
-                    child: node.child[slot],
-                    count: node.count[slot],
-                    t_enter: hits.t_enter[slot],
-                });
+                stack[*len] =
+                    MaybeUninit::new(Postponed { slot: SlotWords::at(&node, slot), t_enter: hits.t_enter[slot] });
                 *len += 1;
             }
         }
@@ -288,7 +282,7 @@ fn expand<const W: usize, M: WideMemory<W> + ?Sized, T: TriangleTest, K: ChildKe
     };
     match node.child[nearest] {
         EMPTY_CHILD => Expanded::EmptyFirst,
-        child => Expanded::Next(SlotWords { child, count: node.count[nearest] }),
+        _ => Expanded::Next(SlotWords::at(&node, nearest)),
     }
 }
 
@@ -331,12 +325,12 @@ fn pop<O: Observer>(
         // SAFETY: entries below `len` were written by a push before `len` passed them (`len`
         // only grows by a push that writes the entry it passes), and `len` was above this one.
         let e = unsafe { stack[*len].assume_init() };
-        if e.child == EMPTY_CHILD {
+        if e.slot.child == EMPTY_CHILD {
             continue;
         }
         obs.backtrack(0, Backtrack::StackPop);
         if e.t_enter <= q.limit() + ctx.t_slack {
-            return Some(SlotWords { child: e.child, count: e.count });
+            return Some(e.slot);
         }
     }
     None

@@ -38,5 +38,6 @@ pub fn kd_leaf<M: KdMemory + ?Sized, T: TriangleTest, O: Observer>(
             }
         }
     }
-    q.hit().is_hit() && q.hit().t + ctx.t_slack < t_max
+    let hit = q.hit();
+    hit.is_hit() && hit.t + ctx.t_slack < t_max
 }
