@@ -593,11 +593,14 @@ mod tests {
         }
     }
 
-    /// A file in a scratch folder of this process.
-    fn scratch(name: &str, data: &[u8]) -> String {
-        let dir = std::env::temp_dir().join(format!("raytrail-cli-args-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(name);
+    /// A scratch folder of the test's own, removed when the test ends.
+    fn scratch_folder() -> tempfile::TempDir {
+        tempfile::Builder::new().prefix("raytrail-cli-args-").tempdir().unwrap()
+    }
+
+    /// A file named `name` holding `data` in `dir`.
+    fn scratch(dir: &tempfile::TempDir, name: &str, data: &[u8]) -> String {
+        let path = dir.path().join(name);
         std::fs::write(&path, data).unwrap();
         path.display().to_string()
     }
@@ -619,7 +622,8 @@ mod tests {
 
     #[test]
     fn lenient_load_warns_once_and_strict_fails() {
-        let path = scratch("edges.obj", OBJ);
+        let dir = scratch_folder();
+        let path = scratch(&dir, "edges.obj", OBJ);
         let (named, report, warning) = load_scene(Path::new(&path), &args("").load_options()).unwrap();
         assert_eq!(named.scene.triangles().len(), 1);
         assert_eq!(report.skipped, 3);
@@ -633,16 +637,17 @@ mod tests {
         let e = load_scene(Path::new(&path), &args("--strict").load_options()).unwrap_err();
         assert_eq!(e, format!("{path}:4: face has 2 vertices; a face needs at least 3"));
         // Nothing skipped: no warning.
-        let clean = scratch("clean.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        let clean = scratch(&dir, "clean.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
         assert_eq!(load_scene(Path::new(&clean), &LoadOptions::default()).unwrap().2, None);
     }
 
     #[test]
     fn prim_map_file() {
-        let path = scratch("map.obj", OBJ);
+        let dir = scratch_folder();
+        let path = scratch(&dir, "map.obj", OBJ);
         let options = LoadOptions { sources: true, ..LoadOptions::default() };
         let (_, report, _) = load_scene(Path::new(&path), &options).unwrap();
-        let out = scratch("map.csv", b"");
+        let out = scratch(&dir, "map.csv", b"");
         write_prim_map(Path::new(&out), Path::new(&path), &report).unwrap();
         assert_eq!(std::fs::read_to_string(&out).unwrap(), format!("prim,file,line\n0,{path},7\n"));
         let e = write_prim_map(Path::new("/nonexistent/dir/map.csv"), Path::new(&path), &report).unwrap_err();

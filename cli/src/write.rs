@@ -165,11 +165,9 @@ fn sync_folder(path: &Path) {
 mod tests {
     use super::*;
 
-    fn folder(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("raytrail-cli-write-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    /// A fresh folder of the test's own, removed when the test ends.
+    fn folder(name: &str) -> tempfile::TempDir {
+        tempfile::Builder::new().prefix(&format!("raytrail-cli-write-{name}-")).tempdir().unwrap()
     }
 
     fn entries(dir: &Path) -> Vec<String> {
@@ -181,17 +179,19 @@ mod tests {
 
     #[test]
     fn a_complete_write_replaces_the_file() {
-        let dir = folder("ok");
+        let scratch = folder("ok");
+        let dir = scratch.path();
         let path = dir.join("out.txt");
         std::fs::write(&path, b"old").unwrap();
         write_atomically(&path, |w| w.write_all(b"new content")).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new content");
-        assert_eq!(entries(&dir), ["out.txt"]);
+        assert_eq!(entries(dir), ["out.txt"]);
     }
 
     #[test]
     fn a_failed_write_leaves_the_old_file_and_no_temporary() {
-        let dir = folder("fail");
+        let scratch = folder("fail");
+        let dir = scratch.path();
         let path = dir.join("out.txt");
         std::fs::write(&path, b"the good file").unwrap();
         let e = write_atomically(&path, |w| {
@@ -202,7 +202,7 @@ mod tests {
         .unwrap_err();
         assert_eq!(e.to_string(), "disk full");
         assert_eq!(std::fs::read(&path).unwrap(), b"the good file");
-        assert_eq!(entries(&dir), ["out.txt"]);
+        assert_eq!(entries(dir), ["out.txt"]);
         // No folder: an error, nothing created.
         assert!(write_atomically(dir.join("no/such/out.txt"), |w| w.write_all(b"x")).is_err());
     }
@@ -210,14 +210,15 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn a_link_is_kept_and_its_target_written() {
-        let dir = folder("link");
+        let scratch = folder("link");
+        let dir = scratch.path();
         let (target, link) = (dir.join("target.txt"), dir.join("link.txt"));
         std::fs::write(&target, b"old").unwrap();
         std::os::unix::fs::symlink("target.txt", &link).unwrap();
         write_atomically(&link, |w| w.write_all(b"new")).unwrap();
         assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
         assert_eq!(std::fs::read(&target).unwrap(), b"new");
-        assert_eq!(entries(&dir), ["link.txt", "target.txt"]);
+        assert_eq!(entries(dir), ["link.txt", "target.txt"]);
         assert!(same_file(&link, &target));
         assert!(!same_file(&link, dir.join("absent")));
     }
@@ -238,7 +239,8 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn a_killed_runs_temporary_file_is_removed_by_the_next_write() {
-        let dir = folder("stale");
+        let scratch = folder("stale");
+        let dir = scratch.path();
         let path = dir.join("out.txt");
         // A process id no process has (above the kernel's limit of 2^22), and this process's own.
         let stale = dir.join(".out.txt.tmp-4194999-0");
@@ -251,6 +253,6 @@ mod tests {
         let live_name = live.file_name().unwrap().to_string_lossy().into_owned();
         let mut want = vec![".other.txt.tmp-4194999-0".to_string(), live_name, "out.txt".to_string()];
         want.sort();
-        assert_eq!(entries(&dir), want);
+        assert_eq!(entries(dir), want);
     }
 }

@@ -1,22 +1,19 @@
 //! `raytrail accuracy` end to end on the built-in scene with a tiny sample: the table, the JSON
 //! and the plot are written, the default methods make no error, and bad flags fail cleanly.
 
-use std::path::PathBuf;
+mod scratch;
+
+use scratch::Scratch;
 use std::process::Command;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_raytrail"))
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raytrail-cli-accuracy-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
 #[test]
 fn a_tiny_run_writes_table_json_and_plot() {
-    let (json, plot) = (tmp("acc.json"), tmp("acc.svg"));
+    let dir = Scratch::new("cli-accuracy");
+    let (json, plot) = (dir.join("acc.json"), dir.join("acc.svg"));
     let out = bin()
         .args(["accuracy", "--scene", "builtin", "-W", "16", "-H", "12", "--sample", "40", "--passes", "1"])
         .args(["--methods", "hash,kd-stack,bvh4", "--rays", "primary,shadow,diffuse,ao", "--ao-rays", "1"])

@@ -1,6 +1,8 @@
 //! The command line end to end: `rays` writes a NumPy ray file, `trace` reads it and writes hits
 //! that match tracing the same rays through the library; bad input gives an error, not a panic.
 
+mod scratch;
+
 use raytrail::core::method::{Bvh2Method, Method};
 use raytrail::core::prepared::PreparedScene;
 use raytrail::core::trace::{Trace, TraceOptions};
@@ -9,6 +11,7 @@ use raytrail::cpu::CpuBackend;
 use raytrail::Builder;
 use raytrail_cli::npy;
 use raytrail_conformance::paths::mesh_path;
+use scratch::Scratch;
 use std::path::PathBuf;
 use std::process::Command;
 use std::sync::Arc;
@@ -17,17 +20,12 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_raytrail"))
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raytrail-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
 #[test]
 fn rays_then_trace_matches_the_library() {
+    let dir = Scratch::new("cli");
     // The Cornell box ships in the conformance crate: no scenes folder is needed.
     let scene = mesh_path("cornell_box.obj");
-    let (rays, hits) = (tmp("rays.npy"), tmp("hits.npy"));
+    let (rays, hits) = (dir.join("rays.npy"), dir.join("hits.npy"));
     let out = bin()
         .args(["rays", "--scene"])
         .arg(&scene)
@@ -67,7 +65,8 @@ fn rays_then_trace_matches_the_library() {
 /// (a file that does not load) with status 1.
 #[test]
 fn bad_input_is_an_error_not_a_panic() {
-    let bad = tmp("bad.npy");
+    let dir = Scratch::new("cli");
+    let bad = dir.join("bad.npy");
     std::fs::write(&bad, b"not a numpy file").unwrap();
     let cases: Vec<(i32, Vec<String>)> = vec![
         (
@@ -123,7 +122,8 @@ fn a_negative_number_is_an_error_naming_its_flag() {
 /// occlusion agrees with the stack method's; without it, a usage error says how to get it.
 #[test]
 fn bench_with_embree_needs_the_feature() {
-    let json = tmp("embree.json");
+    let dir = Scratch::new("cli");
+    let json = dir.join("embree.json");
     let out = bin()
         .args(["bench", "--scene", "builtin", "--peers", "embree", "--baseline", "embree", "--methods", "stack"])
         .args(["--rays", "primary,shadow", "--width", "32", "--height", "24", "--passes", "1", "--threads", "1"])
@@ -155,9 +155,10 @@ fn bench_with_embree_needs_the_feature() {
 /// warning line naming the count and the first location; `--strict` makes it today's error.
 #[test]
 fn short_faces_lines_and_points_warn_by_default_and_fail_under_strict() {
-    let obj = tmp("edges.obj");
+    let dir = Scratch::new("cli");
+    let obj = dir.join("edges.obj");
     std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4\nl 1 2 3\np 4\nf 2 4 3\n").unwrap();
-    let rays = tmp("edges_rays.npy");
+    let rays = dir.join("edges_rays.npy");
     let run = |strict: bool| {
         let mut cmd = bin();
         cmd.args(["rays", "--scene", &obj.display().to_string(), "--out", &rays.display().to_string()]);
@@ -180,6 +181,7 @@ fn short_faces_lines_and_points_warn_by_default_and_fail_under_strict() {
 
 #[test]
 fn render_with_auto_draws_what_its_chosen_method_draws() {
+    let dir = Scratch::new("cli");
     let run = |method: &str, out: &PathBuf| {
         let o = bin()
             .args([
@@ -191,7 +193,7 @@ fn render_with_auto_draws_what_its_chosen_method_draws() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         String::from_utf8_lossy(&o.stderr).into_owned()
     };
-    let auto_png = tmp("auto.png");
+    let auto_png = dir.join("auto.png");
     let told = run("auto", &auto_png);
     let chosen = told
         .lines()
@@ -199,16 +201,17 @@ fn render_with_auto_draws_what_its_chosen_method_draws() {
         .and_then(|l| l.split_whitespace().next())
         .unwrap_or_else(|| panic!("no choice printed: {told}"))
         .to_string();
-    let fixed_png = tmp("fixed.png");
+    let fixed_png = dir.join("fixed.png");
     run(&chosen, &fixed_png);
     assert_eq!(std::fs::read(&auto_png).unwrap(), std::fs::read(&fixed_png).unwrap(), "auto chose {chosen}");
 }
 
 #[test]
 fn the_main_job_on_a_scene_the_camera_rays_miss_says_so_and_passes() {
+    let dir = Scratch::new("cli");
     // Two degenerate triangles on a line: every camera ray misses, so there are no shadow or
     // diffuse rays to choose a method on (it failed with "auto: invalid rays").
-    let scene = tmp("degenerate.obj");
+    let scene = dir.join("degenerate.obj");
     std::fs::write(&scene, "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 3 2\n").unwrap();
     let out =
         bin().args(["run", "--no-gpu", "--width", "16", "--height", "12", "--scene"]).arg(&scene).output().unwrap();
@@ -223,9 +226,10 @@ fn the_main_job_on_a_scene_the_camera_rays_miss_says_so_and_passes() {
 /// `rays --scene /dev/stdin --max-mesh-bytes max` with `data` written to its stdin (a pipe).
 fn rays_from_stdin(data: Vec<u8>, max: &str) -> std::process::Output {
     use std::io::Write;
+    let dir = Scratch::new("cli");
     let mut child = bin()
         .args(["rays", "--scene", "/dev/stdin", "--width", "8", "--height", "6", "--max-mesh-bytes", max, "--out"])
-        .arg(tmp("stdin-rays.npy"))
+        .arg(dir.join("stdin-rays.npy"))
         .stdin(std::process::Stdio::piped())
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
@@ -244,6 +248,7 @@ fn rays_from_stdin(data: Vec<u8>, max: &str) -> std::process::Output {
 #[test]
 fn a_mesh_from_a_pipe_is_read_as_a_stream_with_its_format_from_its_content() {
     use std::io::Write;
+    let dir = Scratch::new("cli");
     let teapot = std::fs::read(mesh_path("teapot.obj")).unwrap();
     // OBJ has no magic number: a pipe has no extension, so the content says what it is.
     let out = rays_from_stdin(teapot.clone(), "100000000");
@@ -258,7 +263,7 @@ fn a_mesh_from_a_pipe_is_read_as_a_stream_with_its_format_from_its_content() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("a stream longer than 100000 bytes"), "{err}");
     // A device is no mesh.
-    let out = bin().args(["rays", "--scene", "/dev/zero", "--out"]).arg(tmp("zero.npy")).output().unwrap();
+    let out = bin().args(["rays", "--scene", "/dev/zero", "--out"]).arg(dir.join("zero.npy")).output().unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("it is a device, not a file or a pipe"));
 }
 
@@ -266,7 +271,7 @@ fn a_mesh_from_a_pipe_is_read_as_a_stream_with_its_format_from_its_content() {
 fn paths_are_taken_as_the_system_has_them_not_only_as_utf8() {
     use std::ffi::OsStr;
     use std::os::unix::ffi::OsStrExt;
-    let dir = tmp("");
+    let dir = Scratch::new("cli");
     let named = |bytes: &[u8]| dir.join(OsStr::from_bytes(bytes));
     let (scene, rays, hits, image) =
         (named(b"tea\xffpot.obj"), named(b"rays\xfe.npy"), named(b"hits\xfd.npy"), named(b"image\xfc.png"));

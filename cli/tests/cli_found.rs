@@ -1,9 +1,12 @@
 //! One test per command-line problem the "ecosystem command line" issue found: each failed before
 //! the command line moved to clap, atomic writes, limits and `render`.
 
+mod scratch;
+
 use raytrail_cli::npy;
 use raytrail_conformance::rays::{primary, Camera};
-use std::path::{Path, PathBuf};
+use scratch::Scratch;
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -11,12 +14,9 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_raytrail"))
 }
 
-/// A fresh scratch folder of this test.
-fn folder(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raytrail-cli-found-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder of the test's own, removed when it passes.
+fn folder(test: &str) -> Scratch {
+    Scratch::new(&format!("cli-found-{test}"))
 }
 
 fn run(args: &[&str]) -> Output {

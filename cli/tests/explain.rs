@@ -2,17 +2,13 @@
 //! needs, kernels) as text and JSON, and bad input is an error with the right exit status, never a
 //! panic.
 
-use std::path::PathBuf;
+mod scratch;
+
+use scratch::Scratch;
 use std::process::{Command, Output};
 
 fn run(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_raytrail")).args(args).output().unwrap()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raytrail-explain-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
 }
 
 fn text(b: &[u8]) -> String {
@@ -21,7 +17,8 @@ fn text(b: &[u8]) -> String {
 
 #[test]
 fn explain_analyses_the_builtin_scene() {
-    let json = tmp("explain.json");
+    let dir = Scratch::new("explain");
+    let json = dir.join("explain.json");
     let out = run(&["explain", "builtin", "-W", "32", "-H", "24", "--json", json.to_str().unwrap()]);
     let stdout = text(&out.stdout);
     assert!(out.status.success(), "{}\n{}", stdout, text(&out.stderr));
@@ -53,6 +50,7 @@ fn explain_analyses_the_builtin_scene() {
 
 #[test]
 fn explain_fails_cleanly_on_bad_input() {
+    let dir = Scratch::new("explain");
     let cases: [(&[&str], i32); 5] = [
         (&["explain", "no/such/scene.obj"], 1),
         (&["explain", "builtin", "--rays", "no/such/rays.npy"], 1),
@@ -67,7 +65,7 @@ fn explain_fails_cleanly_on_bad_input() {
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
     // A file that is not a ray file, and a scene file that is not a mesh.
-    let bad = tmp("bad.npy");
+    let bad = dir.join("bad.npy");
     std::fs::write(&bad, b"not numpy").unwrap();
     for args in [vec!["explain", "builtin", "--rays", bad.to_str().unwrap()], vec!["explain", bad.to_str().unwrap()]] {
         let out = run(&args);
@@ -80,7 +78,8 @@ fn explain_fails_cleanly_on_bad_input() {
 
 #[test]
 fn explain_takes_a_ray_file() {
-    let (rays, json) = (tmp("rays.npy"), tmp("rays.json"));
+    let dir = Scratch::new("explain");
+    let (rays, json) = (dir.join("rays.npy"), dir.join("rays.json"));
     let out = run(&["rays", "--scene", "builtin", "--out", rays.to_str().unwrap(), "-W", "24", "-H", "16"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let out = run(&["explain", "builtin", "--rays", rays.to_str().unwrap(), "--json", json.to_str().unwrap()]);

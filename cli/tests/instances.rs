@@ -2,6 +2,9 @@
 //! names its instance's id, an instance placed by the identity answers as the mesh itself, ray
 //! masks (`--masks`) pick the instances a ray enters, and a file that is wrong says where.
 
+mod scratch;
+
+use scratch::Scratch;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -13,11 +16,9 @@ fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
-fn folder(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raytrail-instances-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder of the test's own, removed when it passes.
+fn folder(name: &str) -> Scratch {
+    Scratch::new(&format!("instances-{name}"))
 }
 
 /// The records of a `.npy` file of version 1 whose header holds `descr`, `size` bytes each.

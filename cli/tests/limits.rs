@@ -2,16 +2,16 @@
 //! asks for gigabytes from a file of one megabyte; the command refuses it by `--max-triangles`
 //! with status 1 and one line, before the copies are allocated, where it used to abort.
 
+mod scratch;
+
+use scratch::Scratch;
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// A fresh folder of the test's own.
-fn folder(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raytrail-limits-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder of the test's own, removed when it passes.
+fn folder(name: &str) -> Scratch {
+    Scratch::new(&format!("limits-{name}"))
 }
 
 /// The command line with its address space limited to `bytes`, as `ulimit -v` would.

@@ -3,7 +3,10 @@
 //! written in place and never replaced, a killed run's temporary file does not pile up, and a full
 //! stdout ends the command with status 1 and one line instead of a panic.
 
+mod scratch;
+
 use raytrail_conformance::paths::mesh_path;
+use scratch::Scratch;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -11,12 +14,9 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_raytrail"))
 }
 
-/// A fresh folder of the test's own.
-fn folder(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raytrail-outputs-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder of the test's own, removed when it passes.
+fn folder(name: &str) -> Scratch {
+    Scratch::new(&format!("outputs-{name}"))
 }
 
 fn run(args: &[&dyn AsRef<std::ffi::OsStr>]) -> Output {

@@ -3,18 +3,19 @@
 //! `trace` writes, the records go ray by ray in order of `t`, and `--max-hits` cuts. `nearest`:
 //! the nearest point to each point of a point file, as the library answers it.
 
-use std::path::{Path, PathBuf};
+mod scratch;
+
+use scratch::Scratch;
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn run(args: &[&dyn AsRef<std::ffi::OsStr>]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_raytrail")).args(args).output().unwrap()
 }
 
-fn folder(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raytrail-all-hits-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder of the test's own, removed when it passes.
+fn folder(name: &str) -> Scratch {
+    Scratch::new(&format!("queries-{name}"))
 }
 
 /// The records of a `.npy` file of version 1 whose header holds `descr`, `size` bytes each.
