@@ -8,7 +8,7 @@
 //! the [`SerialBackend`] ([`compare_backends`](crate::check::compare_backends)). A method the
 //! backend does not support fails the case: the suite never passes over a method in silence.
 
-use crate::check::{check_against, check_complete, compare_hits, trace_all, Context, Mismatch, PrimLeaves};
+use crate::check::{check_against, check_complete, compare_hits, trace_all_recording, Context, Mismatch, PrimLeaves};
 use crate::paths::{find_mesh, load_mesh_scene};
 use crate::rays::{ray_sets, RaySetSize};
 use crate::reference::SerialBackend;
@@ -39,29 +39,40 @@ pub const REFIT_RAYS: RaySetSize = RaySetSize { width: 48, height: 36, uniform_c
 /// Ray set sizes for the tiny cases.
 pub const TINY_RAYS: RaySetSize = RaySetSize { width: 16, height: 16, uniform_count: 512 };
 
-/// One test of the suite.
+/// The tree a case builds over its scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tree {
+    /// Binned SAH ([`SahBuilder`]).
+    Sah,
+    /// PLOC, bottom-up clustering ([`raytrail_build::ploc`]).
+    Ploc,
+    /// Spatial splits ([`SbvhBuilder`]): a cut triangle is referenced from leaves on both sides of
+    /// the plane, and every method must still find each hit once, in whichever leaf it meets it
+    /// first.
+    Sbvh,
+}
+
+/// One test of the suite. A scene with several trees is one case per tree, so that the tests are
+/// short enough to spread evenly over the test threads (as one test, the sphereflake's three trees
+/// ran last and alone on a software GPU for three minutes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Case {
     /// A grid of triangles sharing edges (SAH tree).
     SharedEdgeGrid,
-    /// The sphereflake, with SAH, PLOC and SBVH trees.
-    Sphereflake,
-    /// A random triangle soup, with SAH, PLOC and SBVH trees.
-    TriangleSoup,
+    /// The sphereflake.
+    Sphereflake(Tree),
+    /// A random triangle soup.
+    TriangleSoup(Tree),
     /// A stack of triangles deep enough to need 64-bit keys.
     DegenerateStack,
     /// A scene far from the origin.
     FarFromOrigin,
     /// The tiny hand-made cases.
     TinyCases,
-    /// A mesh of the scenes folder with a SAH tree (the file name).
-    Mesh(&'static str),
-    /// A mesh of the scenes folder with a PLOC tree.
-    MeshPloc(&'static str),
-    /// A mesh of the scenes folder with a tree of spatial splits (SBVH).
-    MeshSbvh(&'static str),
-    /// The sphereflake's SAH and SBVH trees refitted twice as its vertices move ([`breathing`]).
-    Refit,
+    /// A mesh of the scenes folder (the file name).
+    Mesh(&'static str, Tree),
+    /// The sphereflake's tree refitted twice as its vertices move ([`breathing`]).
+    Refit(Tree),
     /// Instances of three generated meshes against their flattened triangles
     /// ([`crate::instanced`]).
     Instanced,
@@ -73,24 +84,30 @@ pub enum Case {
     Nearest,
 }
 
+/// Builds `tree` over `named`'s triangles.
+pub fn build_tree(named: &NamedScene, tree: Tree) -> Bvh2 {
+    let triangles = named.scene.triangles();
+    match tree {
+        Tree::Sah => SahBuilder::default().build(triangles).expect("SAH build"),
+        Tree::Ploc => raytrail_build::ploc::build_ploc(triangles, 63).expect("PLOC build"),
+        Tree::Sbvh => {
+            let bvh = SbvhBuilder::default().build(triangles).expect("SBVH build");
+            assert!(bvh.has_split_references(), "{}: the SBVH case should cut triangles", named.name);
+            bvh
+        }
+    }
+}
+
 /// Runs one case on `backend`; panics with a loud report on any mismatch.
 pub fn run_case<B: Trace>(backend: &B, case: Case) {
-    let sah = |s: &NamedScene| SahBuilder::default().build(s.scene.triangles()).expect("SAH build");
-    let ploc = |s: &NamedScene| raytrail_build::ploc::build_ploc(s.scene.triangles(), 63).expect("PLOC build");
-    // Spatial splits reference a cut triangle from leaves on both sides of the plane: the suite
-    // checks that every method still finds each hit once, in whichever leaf it meets it first.
-    let sbvh = |s: &NamedScene| {
-        let bvh = SbvhBuilder::default().build(s.scene.triangles()).expect("SBVH build");
-        assert!(bvh.has_split_references(), "{}: the SBVH case should cut triangles", s.name);
-        bvh
-    };
+    let sah = |s: &NamedScene| build_tree(s, Tree::Sah);
     match case {
         Case::SharedEdgeGrid => check_scene(backend, &generated_scene("shared_edge_grid"), sah, GENERATED_RAYS),
-        Case::Sphereflake | Case::TriangleSoup => {
-            let s = generated_scene(if case == Case::Sphereflake { "sphereflake" } else { "triangle_soup" });
-            check_scene(backend, &s, sah, GENERATED_RAYS);
-            check_scene(backend, &s, ploc, GENERATED_RAYS);
-            check_scene(backend, &s, sbvh, GENERATED_RAYS);
+        Case::Sphereflake(tree) => {
+            check_scene(backend, &generated_scene("sphereflake"), |s| build_tree(s, tree), GENERATED_RAYS)
+        }
+        Case::TriangleSoup(tree) => {
+            check_scene(backend, &generated_scene("triangle_soup"), |s| build_tree(s, tree), GENERATED_RAYS)
         }
         Case::DegenerateStack => {
             let s = generated_scene("degenerate_stack");
@@ -107,27 +124,13 @@ pub fn run_case<B: Trace>(backend: &B, case: Case) {
                 check_scene(backend, &s, sah, TINY_RAYS);
             }
         }
-        Case::Mesh(file) => {
+        Case::Mesh(file, tree) => {
             if let Some(s) = mesh(file) {
-                check_scene(backend, &s, sah, MESH_RAYS);
+                check_scene(backend, &s, |s| build_tree(s, tree), MESH_RAYS);
             }
         }
-        Case::MeshPloc(file) => {
-            if let Some(s) = mesh(file) {
-                check_scene(backend, &s, ploc, MESH_RAYS);
-            }
-        }
-        Case::MeshSbvh(file) => {
-            if let Some(s) = mesh(file) {
-                check_scene(backend, &s, sbvh, MESH_RAYS);
-            }
-        }
-        Case::Refit => {
-            let s = generated_scene("sphereflake");
-            check_refit(backend, &s, sah, REFIT_RAYS);
-            // A split tree refits to whole triangles' boxes: its clipped boxes do not survive.
-            check_refit(backend, &s, sbvh, REFIT_RAYS);
-        }
+        // A split tree refits to whole triangles' boxes: its clipped boxes do not survive.
+        Case::Refit(tree) => check_refit(backend, &generated_scene("sphereflake"), |s| build_tree(s, tree), REFIT_RAYS),
         Case::Instanced => check_instanced(backend),
         Case::AllHits => crate::all_hits::check_backend(backend),
         Case::Nearest => crate::nearest::check_backend(backend),
@@ -309,8 +312,12 @@ pub fn refit_mismatches<B: Trace>(
     for set in ray_sets(&named.scene, size, &mut trace_closest) {
         let ctx = Context { scene: &named.name, ray_set: set.kind.name(), backend: backend.name() };
         for query in Query::ALL {
-            let expected = trace_all(&serial, &fresh, &set.rays, &stack, query).expect("trace");
-            let got = trace_all(backend, &scene, &set.rays, &Method::ALL, query).expect("trace");
+            // Hits alone are compared here, so no node visits are recorded (`check_prepared` checks
+            // those on the refitted tree).
+            let expected =
+                trace_all_recording(&serial, &fresh, &set.rays, &stack, query, Record::Nothing).expect("trace");
+            let got =
+                trace_all_recording(backend, &scene, &set.rays, &Method::ALL, query, Record::Nothing).expect("trace");
             // Each method against the fresh scene's stack method: the same outcome under each name.
             let expected: Vec<_> =
                 got.iter().map(|o| crate::check::Outcome { method: o.method, ..expected[0].clone() }).collect();
@@ -352,10 +359,12 @@ pub fn mismatch_report(scene: &str, backend: &str, checked: usize, mismatches: &
 /// Defines one `#[test]` per [`Case`] of the suite for a backend:
 /// `conformance_suite!(CpuBackend::new());`, or with `try` for a constructor returning a
 /// `Result` (a backend is then made once for each test running at once and kept for the tests
-/// after it, and skipped if it cannot be made unless [`REQUIRE_GPU`] is 1: [`run_case_or_skip`]). `small: try ...` defines only the cases that reach every kernel
-/// and both key widths without the large meshes (generated scenes, with SAH, PLOC and SBVH trees,
-/// the Cornell box and the teapot), for a second configuration of a backend whose every kernel the full suite already
-/// ran on every mesh.
+/// after it, and skipped if it cannot be made unless [`REQUIRE_GPU`] is 1: [`run_case_or_skip`]).
+/// `small: try ...` defines only the cases that reach every kernel, both key widths and each
+/// tree builder once without the large meshes (the generated scenes, the sphereflake with SAH and
+/// SBVH trees, the soup with a PLOC tree, the Cornell box and the teapot), for a second
+/// configuration of a backend whose every kernel the full suite already ran on every scene and
+/// tree.
 #[macro_export]
 macro_rules! conformance_suite {
     (small: try $make:expr) => {
@@ -370,38 +379,45 @@ macro_rules! conformance_suite {
     (@small $run:expr) => {
         $crate::conformance_suite!(@each $run;
             shared_edge_grid => SharedEdgeGrid,
-            sphereflake => Sphereflake,
-            triangle_soup => TriangleSoup,
+            sphereflake => Sphereflake(Sah),
+            sphereflake_with_sbvh => Sphereflake(Sbvh),
+            triangle_soup_with_ploc => TriangleSoup(Ploc),
             degenerate_stack_needs_and_uses_64_bit_keys => DegenerateStack,
             far_from_origin => FarFromOrigin,
             tiny_cases => TinyCases,
             instanced => Instanced,
             all_hits => AllHits,
             nearest => Nearest,
-            cornell_box => Mesh("cornell_box.obj"),
-            teapot => Mesh("teapot.obj"),
+            cornell_box => Mesh("cornell_box.obj", Sah),
+            teapot => Mesh("teapot.obj", Sah),
         );
     };
     (@cases $run:expr) => {
         $crate::conformance_suite!(@small $run);
         $crate::conformance_suite!(@each $run;
-            kitchen => Mesh("kitchen.obj"),
-            sponza => Mesh("sponza.obj"),
-            bunny => Mesh("bunny.obj"),
-            dragon_res2 => Mesh("dragon_vrip_res2.ply.gz"),
-            dragon_full => Mesh("dragon_vrip.ply.gz"),
-            bunny_with_ploc => MeshPloc("bunny.obj"),
-            cornell_box_with_sbvh => MeshSbvh("cornell_box.obj"),
-            sponza_with_sbvh => MeshSbvh("sponza.obj"),
-            refit_sphereflake => Refit,
+            sphereflake_with_ploc => Sphereflake(Ploc),
+            triangle_soup => TriangleSoup(Sah),
+            triangle_soup_with_sbvh => TriangleSoup(Sbvh),
+            kitchen => Mesh("kitchen.obj", Sah),
+            sponza => Mesh("sponza.obj", Sah),
+            bunny => Mesh("bunny.obj", Sah),
+            dragon_res2 => Mesh("dragon_vrip_res2.ply.gz", Sah),
+            dragon_full => Mesh("dragon_vrip.ply.gz", Sah),
+            bunny_with_ploc => Mesh("bunny.obj", Ploc),
+            cornell_box_with_sbvh => Mesh("cornell_box.obj", Sbvh),
+            sponza_with_sbvh => Mesh("sponza.obj", Sbvh),
+            refit_sphereflake => Refit(Sah),
+            refit_sphereflake_with_sbvh => Refit(Sbvh),
         );
     };
-    (@each $run:expr; $($name:ident => $case:ident $(($file:expr))?,)*) => {
+    (@each $run:expr; $($name:ident => $case:expr,)*) => {
         $(
             #[test]
             fn $name() {
+                #[allow(unused_imports)]
+                use $crate::suite::{Case::*, Tree::*};
                 let run: fn($crate::suite::Case) = $run;
-                run($crate::suite::Case::$case $(($file))?);
+                run($case);
             }
         )*
     };
