@@ -4,9 +4,10 @@
 //! in workgroups of 32 (four resident workgroups fetching from the counter). Each method's hits
 //! and enumerations must equal the serial reference backend's, bit for bit.
 //!
-//! The cases that reach every kernel and both key widths (generated scenes, the small meshes):
-//! conformance.rs runs every kernel on the large meshes already, and on lavapipe a rerun of those
-//! here was the suite's largest cost in CI. An adapter that cannot take SPIR-V runs the WGSL
+//! The cases that reach every kernel, both key widths and each tree builder once (generated
+//! scenes, the small meshes): conformance.rs runs every kernel on the large meshes and on every
+//! tree of the generated scenes already, and on lavapipe a rerun of those here was the suite's
+//! largest cost in CI. An adapter that cannot take SPIR-V runs the WGSL
 //! kernels instead, with a line saying so, unless `RAYTRAIL_REQUIRE_GPU=1`, which makes that a
 //! failure.
 //!
