@@ -1,6 +1,7 @@
 // One invocation per work item, over rows of `P.row_width` invocations (a large batch exceeds one
-// dimension's workgroup limit). The workgroup size is a pipeline override, so a sweep compiles
-// variants rather than editing the source.
+// dimension's workgroup limit), each checked by loop_guard.wgsl (bound before this file) when its
+// item is done. The workgroup size is a pipeline override, so a sweep compiles variants rather than
+// editing the source.
 
 override WORKGROUP_SIZE: u32 = 64u;
 
@@ -11,4 +12,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     run_item(i);
+    guard_loops();
 }

@@ -2,7 +2,8 @@
 // fetches the next WORKGROUP_SIZE items from a global counter whenever all of its invocations are
 // done, so a workgroup of long rays does not hold back a whole dispatch's tail. The batch is fetched
 // per workgroup rather than per warp because WGSL has no portable warp: with WORKGROUP_SIZE 32 on
-// NVIDIA the two are the same. The host zeroes `next_item` before every dispatch.
+// NVIDIA the two are the same. The host zeroes `next_item` (loop_guard.wgsl's `DispatchState`, bound
+// before this file) before every dispatch.
 //
 // A workgroup stops after `P.persistent_rounds` rounds even if items are left: the host launches
 // enough workgroups that they cover the batch within that many rounds. Without the bound, a device
@@ -11,8 +12,6 @@
 
 override WORKGROUP_SIZE: u32 = 64u;
 
-@group(0) @binding(7) var<storage, read_write> next_item: atomic<u32>;
-
 var<workgroup> batch_start: u32;
 
 @compute @workgroup_size(WORKGROUP_SIZE)
@@ -20,7 +19,7 @@ fn main(@builtin(local_invocation_index) lane: u32) {
     let n = item_count();
     for (var round = 0u; round < P.persistent_rounds; round = round + 1u) {
         if lane == 0u {
-            batch_start = atomicAdd(&next_item, WORKGROUP_SIZE);
+            batch_start = atomicAdd(&dispatch_state.next_item, WORKGROUP_SIZE);
         }
         // A barrier on either side of the load: every invocation sees this round's start, and
         // invocation 0 writes the next one only after all have read it.
@@ -33,4 +32,6 @@ fn main(@builtin(local_invocation_index) lane: u32) {
             run_item(i);
         }
     }
+    // After the fetch loop: a limiter that cut it short left items untraced.
+    guard_loops();
 }

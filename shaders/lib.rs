@@ -77,6 +77,9 @@ pub const KEYS32: Source = Source { name: "keys32.wgsl", text: include_str!("key
 /// `keys64.wgsl`.
 pub const KEYS64: Source = Source { name: "keys64.wgsl", text: include_str!("keys64.wgsl") };
 
+/// `loop_guard.wgsl`.
+pub const LOOP_GUARD: Source = Source { name: "loop_guard.wgsl", text: include_str!("loop_guard.wgsl") };
+
 /// `nearest.wgsl`.
 pub const NEAREST: Source = Source { name: "nearest.wgsl", text: include_str!("nearest.wgsl") };
 
@@ -220,6 +223,7 @@ pub const ALL: &[Source] = &[
     KD_STACK,
     KEYS32,
     KEYS64,
+    LOOP_GUARD,
     NEAREST,
     NUMERICS,
     PRELUDE,

@@ -1,7 +1,7 @@
 // Method bvh8-packet: bvh8's tree walked by packets of WIDE_PACKET rays of one direction octant
 // (`wide::packet`), a packet to a workgroup and a ray to an invocation. The host arranges the batch
 // into the core's packets (padding as untraceable rays), so workgroup p traces slots
-// `WIDE_PACKET * p ..`. The rule is the core's, step for step:
+// `WIDE_PACKET * p ..`; loop_guard.wgsl follows this file. The rule is the core's, step for step:
 // - every ray of the current mask records the visit and, at a node, tests the children with the
 //   single-ray box test over its own interval; per child, the rays that hit it gather into a mask
 //   and their least entry distance into its key (workgroup atomics);
@@ -248,4 +248,5 @@ fn main(
     if have {
         hits[slot] = Q_HIT;
     }
+    guard_loops();
 }

@@ -78,8 +78,13 @@ fn persistent_rounds(gpu: &Gpu) -> usize {
 /// The dispatch of `items` work items: workgroups in x and y, the grid's row width, and the rounds
 /// a persistent workgroup fetches at most (the workgroups cover the items within them).
 pub(crate) fn grid(gpu: &Gpu, launch: &Launch<'_>, items: usize) -> Result<Dispatched, Error> {
+    grid_in_rounds(gpu, launch, items, persistent_rounds(gpu))
+}
+
+/// [`grid`] with persistent workgroups that fetch at most `rounds` times.
+fn grid_in_rounds(gpu: &Gpu, launch: &Launch<'_>, items: usize, rounds: usize) -> Result<Dispatched, Error> {
     let wg = launch.config.workgroup_size as usize;
-    let rounds = persistent_rounds(gpu);
+    let rounds = rounds.max(1);
     // `launch` resolved the dispatch for its method (`Dispatch::for_method`): never `ByMethod` here.
     let groups = match launch.config.dispatch {
         Dispatch::Grid | Dispatch::ByMethod => items.div_ceil(wg),
@@ -158,7 +163,8 @@ pub(crate) enum Stamps<'q> {
     Around { queries: &'q wgpu::QuerySet, begin: bool, end: bool },
 }
 
-/// Records one batch's pass in `enc` (the item counter zeroed first for persistent threads).
+/// Records one batch's pass in `enc`: the kernel's scratch zeroed first (for persistent threads
+/// all of it, the item counter; else its first 16 bytes, the loop guard's flag), then the pass.
 pub(crate) fn encode(
     gpu: &Gpu,
     enc: &mut wgpu::CommandEncoder,
@@ -167,9 +173,11 @@ pub(crate) fn encode(
     dims: (u32, u32),
     stamps: Stamps<'_>,
 ) {
-    if let Dispatch::Persistent { .. } = launch.config.dispatch {
-        enc.clear_buffer(&slot.scratch, 0, None);
-    }
+    let zeroed = match launch.config.dispatch {
+        Dispatch::Persistent { .. } => None,
+        Dispatch::Grid | Dispatch::ByMethod => Some(DISPATCH_STATE_BYTES),
+    };
+    enc.clear_buffer(&slot.scratch, 0, zeroed);
     let bind = slot.bind_group(gpu, launch.bind_layout, launch.method, &launch.scene).clone();
     let timestamp_writes = match stamps {
         Stamps::Slot => slot.timer.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
@@ -214,7 +222,8 @@ pub(crate) fn run(
     let max_bytes = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
     let period = f64::from(gpu.queue.get_timestamp_period()) * 1e-9;
     let mut pending: VecDeque<Pending> = VecDeque::new();
-    let mut finish = |p: Pending, hits: &mut [Hit], records: &mut [u32], ws: &mut Workspace| -> Result<(), Error> {
+    // Waits for batch `p` and copies out its results; true if the loop guard found its loops cut.
+    let mut finish = |p: Pending, hits: &mut [Hit], records: &mut [u32], ws: &mut Workspace| -> Result<bool, Error> {
         gpu.device
             .poll(wgpu::PollType::Wait { submission_index: Some(p.submission), timeout: None })
             .map_err(|e| device_error(format!("waiting for the device: {e}")))?;
@@ -240,61 +249,124 @@ pub(crate) fn run(
         } else {
             gpu_seconds = None;
         }
-        Ok(())
+        let mut state = [0u32; 4];
+        if slot.mapped & 8 != 0 {
+            take(&slot.scratch_back, &mut state)?;
+            slot.mapped &= !8;
+        }
+        Ok(state[1] != 0)
+    };
+    // `finish`, and a batch whose loops were cut traced again with one item per invocation: its
+    // persistent workgroups had fetched several (lavapipe's limit counts them all); if that is cut
+    // too, or it was one item each already, an error.
+    let mut settle = |p: Pending, hits: &mut [Hit], records: &mut [u32], ws: &mut Workspace| -> Result<(), Error> {
+        let (slot, first, n) = (p.slot, p.first, p.rays);
+        if !finish(p, hits, records, ws)? {
+            return Ok(());
+        }
+        let several = matches!(launch.config.dispatch, Dispatch::Persistent { .. }) && persistent_rounds(gpu) > 1;
+        if several {
+            let again = submit(gpu, ws, launch, slot, &rays[first..first + n], first, 1)?;
+            if !finish(again, hits, records, ws)? {
+                return Ok(());
+            }
+        }
+        Err(loops_cut(n))
     };
     gpu.checked("tracing a stream of batches", || -> Result<(), Error> {
         for (b, chunk) in rays.chunks(per_batch).enumerate() {
             let slot_index = b % launch.config.in_flight;
             if pending.len() >= launch.config.in_flight {
                 if let Some(p) = pending.pop_front() {
-                    finish(p, hits, &mut records, ws)?;
+                    settle(p, hits, &mut records, ws)?;
                 }
             }
-            let n = chunk.len();
-            let items = n.div_ceil(launch.rays_per_item);
-            let d = grid(gpu, launch, items)?;
-            let params = d.params(launch.params, n);
-            let need = SlotNeeds { rays: n, record_words: n * stride, scratch_bytes: launch.scratch_bytes(n) };
-            let slot = ws.slot(gpu, slot_index, need, max_bytes);
-            slot.unmap_leftovers();
-            gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&params));
-            gpu.queue.write_buffer(&slot.rays, 0, bytemuck::cast_slice(chunk));
-            if launch.scratch_per_item > 0 {
-                rounds(gpu, launch, slot, params, (d.x, d.y))?;
-            }
-            let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
-            if launch.scratch_per_item == 0 {
-                encode(gpu, &mut enc, launch, slot, (d.x, d.y), Stamps::Slot);
-            }
-            let hit_bytes = n as u64 * HIT_BYTES;
-            enc.copy_buffer_to_buffer(&slot.hits, 0, &slot.hit_back, 0, hit_bytes);
-            let record_bytes = (n * stride * 4) as u64;
-            if record_bytes > 0 {
-                enc.copy_buffer_to_buffer(&slot.records, 0, &slot.record_back, 0, record_bytes);
-            }
-            if let Some(t) = &slot.timer {
-                enc.resolve_query_set(&t.queries, 0..2, &t.resolve, 0);
-                enc.copy_buffer_to_buffer(&t.resolve, 0, &t.back, 0, 16);
-            }
-            let submission = gpu.queue.submit([enc.finish()]);
-            let mut mapped = vec![map(&slot.hit_back, hit_bytes)];
-            slot.mapped = 1;
-            if record_bytes > 0 {
-                mapped.push(map(&slot.record_back, record_bytes));
-                slot.mapped |= 2;
-            }
-            if let Some(t) = &slot.timer {
-                mapped.push(map(&t.back, 16));
-                slot.mapped |= 4;
-            }
-            pending.push_back(Pending { slot: slot_index, first: b * per_batch, rays: n, submission, mapped });
+            pending.push_back(submit(gpu, ws, launch, slot_index, chunk, b * per_batch, persistent_rounds(gpu))?);
         }
         while let Some(p) = pending.pop_front() {
-            finish(p, hits, &mut records, ws)?;
+            settle(p, hits, &mut records, ws)?;
         }
         Ok(())
     })??;
     Ok(StreamOut { records, gpu_seconds })
+}
+
+/// Uploads `chunk` (the stream's rays from `first` on) to slot `slot_index`, dispatches it with
+/// persistent workgroups fetching at most `rounds` times, and starts reading back its hits,
+/// records, timestamps and dispatch state.
+fn submit(
+    gpu: &Gpu,
+    ws: &mut Workspace,
+    launch: &Launch<'_>,
+    slot_index: usize,
+    chunk: &[Ray],
+    first: usize,
+    rounds: usize,
+) -> Result<Pending, Error> {
+    let stride = launch.params.record_stride as usize;
+    let max_bytes = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+    let n = chunk.len();
+    let items = n.div_ceil(launch.rays_per_item);
+    let d = grid_in_rounds(gpu, launch, items, rounds)?;
+    let params = d.params(launch.params, n);
+    let need = SlotNeeds { rays: n, record_words: n * stride, scratch_bytes: launch.scratch_bytes(n) };
+    let slot = ws.slot(gpu, slot_index, need, max_bytes);
+    slot.unmap_leftovers();
+    gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&params));
+    gpu.queue.write_buffer(&slot.rays, 0, bytemuck::cast_slice(chunk));
+    if launch.scratch_per_item > 0 {
+        rounds_of_streams(gpu, launch, slot, params, (d.x, d.y))?;
+    }
+    let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
+    // The kernels of the dispatch files carry the loop guard; the stream kernel's rounds read the
+    // scratch themselves.
+    let guarded = launch.scratch_per_item == 0;
+    if guarded {
+        encode(gpu, &mut enc, launch, slot, (d.x, d.y), Stamps::Slot);
+        enc.copy_buffer_to_buffer(&slot.scratch, 0, &slot.scratch_back, 0, DISPATCH_STATE_BYTES);
+    }
+    let hit_bytes = n as u64 * HIT_BYTES;
+    enc.copy_buffer_to_buffer(&slot.hits, 0, &slot.hit_back, 0, hit_bytes);
+    let record_bytes = (n * stride * 4) as u64;
+    if record_bytes > 0 {
+        enc.copy_buffer_to_buffer(&slot.records, 0, &slot.record_back, 0, record_bytes);
+    }
+    if let Some(t) = &slot.timer {
+        enc.resolve_query_set(&t.queries, 0..2, &t.resolve, 0);
+        enc.copy_buffer_to_buffer(&t.resolve, 0, &t.back, 0, 16);
+    }
+    let submission = gpu.queue.submit([enc.finish()]);
+    let mut mapped = vec![map(&slot.hit_back, hit_bytes)];
+    slot.mapped = 1;
+    if record_bytes > 0 {
+        mapped.push(map(&slot.record_back, record_bytes));
+        slot.mapped |= 2;
+    }
+    if let Some(t) = &slot.timer {
+        mapped.push(map(&t.back, 16));
+        slot.mapped |= 4;
+    }
+    if guarded {
+        mapped.push(map(&slot.scratch_back, DISPATCH_STATE_BYTES));
+        slot.mapped |= 8;
+    }
+    Ok(Pending { slot: slot_index, first, rays: n, submission, mapped })
+}
+
+/// Bytes of the dispatch state at the start of the kernel's scratch (shaders/loop_guard.wgsl's
+/// `DispatchState`: the persistent item counter, then the loop guard's flag), rounded to 16.
+pub(crate) const DISPATCH_STATE_BYTES: u64 = 16;
+
+/// The error for a batch of `rays` rays whose loops the device cut short, even with one item per
+/// invocation. Mesa's llvmpipe ends a SIMD group's loops once they have run 65,535 iterations in
+/// all and says nothing; the walks it cut report misses, so the batch's hits are refused rather
+/// than returned.
+pub(crate) fn loops_cut(rays: usize) -> Error {
+    device_error(format!(
+        "the device cut the kernel's loops short in a batch of {rays} rays (Mesa's llvmpipe ends a \
+         group of invocations' loops after 65,535 iterations in all), so its hits would be \
+         incomplete; trace these rays with a method of shorter walks or on another adapter"
+    ))
 }
 
 /// The stream kernel's rounds over one batch (shaders/wide_ray_stream.wgsl): dispatched, each on
@@ -302,7 +374,13 @@ pub(crate) fn run(
 /// all. On a GPU one round does it; a CPU adapter takes [`CPU_ADAPTER_STREAM_STEPS`] steps a
 /// round. Every round takes a step at least, and a stream at most nine per node it visits (the
 /// visit, its copy and up to seven pops), so `9 * max_steps` steps bound the rounds.
-fn rounds(gpu: &Gpu, launch: &Launch<'_>, slot: &mut Slot, params: Params, dims: (u32, u32)) -> Result<(), Error> {
+fn rounds_of_streams(
+    gpu: &Gpu,
+    launch: &Launch<'_>,
+    slot: &mut Slot,
+    params: Params,
+    dims: (u32, u32),
+) -> Result<(), Error> {
     let steps = if gpu.info.device_type == wgpu::DeviceType::Cpu { CPU_ADAPTER_STREAM_STEPS } else { u32::MAX };
     let most = 9 * u64::from(params.max_steps) / u64::from(steps) + 2;
     for round in 0..most {

@@ -52,6 +52,7 @@ const ALL_HITS: Part = part!(ALL_HITS);
 const NEAREST: Part = part!(NEAREST);
 const DISPATCH_GRID: Part = part!(DISPATCH_GRID);
 const DISPATCH_PERSISTENT: Part = part!(DISPATCH_PERSISTENT);
+const LOOP_GUARD: Part = part!(LOOP_GUARD);
 const WIDE: Part = part!(WIDE);
 const WIDE_PACKET: Part = part!(WIDE_PACKET);
 const WIDE_RAY_STREAM: Part = part!(WIDE_RAY_STREAM);
@@ -104,6 +105,14 @@ pub enum DispatchKind {
 }
 
 impl DispatchKind {
+    /// Its files: the loop guard, then the dispatch file.
+    fn parts(self) -> [Part; 2] {
+        match self {
+            DispatchKind::Grid => [LOOP_GUARD, DISPATCH_GRID],
+            DispatchKind::Persistent => [LOOP_GUARD, DISPATCH_PERSISTENT],
+        }
+    }
+
     /// The dispatch file `method` compiles under `dispatch` ([`Dispatch::for_method`]).
     pub fn of(dispatch: Dispatch, method: Method) -> DispatchKind {
         match dispatch.for_method(method) {
@@ -147,18 +156,21 @@ impl Variant {
             return Ok(parts);
         }
         // The wide packet and stream kernels have their own entry points (a packet or a stream to
-        // a workgroup).
-        if self.method.wide().is_some_and(|m| m.walk().shares_walks()) {
-            return Ok(parts);
+        // a workgroup). The packet kernel ends with the loop guard; the stream kernel, whose
+        // scratch holds its lists, bounds its steps per round instead (`CPU_ADAPTER_STREAM_STEPS`).
+        match self.method.wide().map(|m| m.walk()) {
+            Some(WideWalk::Packet) => {
+                parts.push(LOOP_GUARD);
+                return Ok(parts);
+            }
+            Some(WideWalk::RayLists) => return Ok(parts),
+            _ => {}
         }
         // The kd packet kernel defines its own work items (one packet each).
         if self.method != Method::Kd(KdMethod::Packet) {
             parts.push(ENTRY);
         }
-        parts.push(match self.dispatch {
-            DispatchKind::Grid => DISPATCH_GRID,
-            DispatchKind::Persistent => DISPATCH_PERSISTENT,
-        });
+        parts.extend(self.dispatch.parts());
         Ok(parts)
     }
 
@@ -183,10 +195,7 @@ impl Variant {
             Answer::Nearest => parts.push(NEAREST),
             Answer::Hit => {}
         }
-        parts.push(match self.dispatch {
-            DispatchKind::Grid => DISPATCH_GRID,
-            DispatchKind::Persistent => DISPATCH_PERSISTENT,
-        });
+        parts.extend(self.dispatch.parts());
         Ok(parts)
     }
 

@@ -78,8 +78,8 @@ impl KernelTiming {
 
 /// The batches of one timed method, uploaded to their slots.
 struct Uploaded {
-    /// Per batch: its slot and workgroups in x and y.
-    batches: Vec<(usize, (u32, u32))>,
+    /// Per batch: its slot, workgroups in x and y, and rays.
+    batches: Vec<(usize, (u32, u32), usize)>,
 }
 
 impl WgpuBackend {
@@ -189,7 +189,7 @@ fn upload(gpu: &Gpu, ws: &mut Workspace, launch: &Launch<'_>, rays: &[Ray]) -> R
         let slot = ws.slot(gpu, b, need, max_bytes);
         gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&params));
         gpu.queue.write_buffer(&slot.rays, 0, bytemuck::cast_slice(chunk));
-        batches.push((b, (d.x, d.y)));
+        batches.push((b, (d.x, d.y), n));
     }
     Ok(Uploaded { batches })
 }
@@ -207,7 +207,7 @@ fn passes(
     let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("timed passes") });
     let last = count * up.batches.len() - 1;
     for k in 0..count * up.batches.len() {
-        let (slot_index, (x, y)) = up.batches[k % up.batches.len()];
+        let (slot_index, (x, y), _) = up.batches[k % up.batches.len()];
         let slot = ws.slot(gpu, slot_index, SlotNeeds::default(), max_bytes);
         let stamps = Stamps::Around { queries, begin: k == 0, end: k == last };
         batch::encode(gpu, &mut enc, launch, slot, (x, y), stamps);
@@ -226,8 +226,21 @@ fn passes(
     });
     enc.resolve_query_set(queries, 0..2, &resolve, 0);
     enc.copy_buffer_to_buffer(&resolve, 0, &back, 0, 16);
+    // Each batch's last pass left its loop guard's flag (shaders/loop_guard.wgsl) in its scratch:
+    // a time is not reported for walks the device cut short.
+    for &(slot_index, _, _) in &up.batches {
+        let slot = ws.slot(gpu, slot_index, SlotNeeds::default(), max_bytes);
+        enc.copy_buffer_to_buffer(&slot.scratch, 0, &slot.scratch_back, 0, batch::DISPATCH_STATE_BYTES);
+    }
     gpu.queue.submit([enc.finish()]);
     let stamps = batch::read::<u64>(gpu, &back, 2)?;
+    for &(slot_index, _, rays) in &up.batches {
+        let slot = ws.slot(gpu, slot_index, SlotNeeds::default(), max_bytes);
+        let state = batch::read::<u32>(gpu, &slot.scratch_back, 4)?;
+        if state[1] != 0 {
+            return Err(batch::loops_cut(rays));
+        }
+    }
     let period = f64::from(gpu.queue.get_timestamp_period()) * 1e-9;
     Ok(stamps[1].saturating_sub(stamps[0]) as f64 * period / count as f64)
 }

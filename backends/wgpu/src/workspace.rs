@@ -23,12 +23,13 @@ pub(crate) struct Slot {
     pub rays: wgpu::Buffer,
     pub hits: wgpu::Buffer,
     pub records: wgpu::Buffer,
-    /// The kernel's scratch: the persistent kernels' item counter (zeroed before every
-    /// dispatch), or the stream kernel's lists.
+    /// The kernel's scratch: the dispatch state (the persistent kernels' item counter and the
+    /// loop guard's flag, zeroed before every dispatch), or the stream kernel's lists.
     pub scratch: wgpu::Buffer,
     pub hit_back: wgpu::Buffer,
     pub record_back: wgpu::Buffer,
-    /// The scratch's first 16 bytes read back (the stream kernel's unfinished streams).
+    /// The scratch's first 16 bytes read back (the stream kernel's unfinished streams, or the
+    /// dispatch state with the loop guard's flag).
     pub scratch_back: wgpu::Buffer,
     /// Two timestamps around the batch's pass, resolved and read back with the hits.
     pub timer: Option<Timer>,
@@ -41,7 +42,7 @@ pub(crate) struct Slot {
     /// Bind groups by method (a method binds the same scene buffers every time).
     binds: HashMap<Method, wgpu::BindGroup>,
     /// Read-back buffers mapped or being mapped and not yet read: bit 0 hits, 1 records, 2 the
-    /// timestamps.
+    /// timestamps, 3 the scratch's first 16 bytes.
     pub mapped: u8,
 }
 
@@ -169,7 +170,12 @@ impl Slot {
     /// Unmaps read-back buffers a failed trace left mapped (or waiting to be), so that the slot can
     /// take a new batch.
     pub fn unmap_leftovers(&mut self) {
-        let backs = [Some(&self.hit_back), Some(&self.record_back), self.timer.as_ref().map(|t| &t.back)];
+        let backs = [
+            Some(&self.hit_back),
+            Some(&self.record_back),
+            self.timer.as_ref().map(|t| &t.back),
+            Some(&self.scratch_back),
+        ];
         for (bit, b) in backs.into_iter().enumerate() {
             if let Some(b) = b.filter(|_| self.mapped & (1 << bit) != 0) {
                 b.unmap();
