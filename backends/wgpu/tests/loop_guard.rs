@@ -18,7 +18,7 @@ use raytrail_core::prepared::PreparedScene;
 use raytrail_core::scene::Scene;
 use raytrail_core::trace::{Trace, TraceOptions};
 use raytrail_core::{Hit, Ray};
-use raytrail_wgpu::{Dispatch, GpuConfig, TimingPlan, WgpuBackend};
+use raytrail_wgpu::{Dispatch, GpuConfig, KernelForm, TimingPlan, WgpuBackend};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -29,9 +29,10 @@ const COPIES: usize = 70_000;
 fn a_walk_the_device_cut_short_is_an_error_not_a_miss() {
     let grid = GpuConfig { dispatch: Dispatch::Grid, ..GpuConfig::default() };
     let persistent = GpuConfig { dispatch: Dispatch::Persistent { workgroups: 4 }, workgroup_size: 32, ..grid };
-    for config in [grid, persistent] {
-        let Some(backend) = common::open_or_skip("the loop guard check", || WgpuBackend::new()?.configured(config))
-        else {
+    // Both kernel forms: the guard must survive the SPIR-V path's compiler as well as WGSL's.
+    for (form, config) in [(KernelForm::Auto, grid), (KernelForm::Auto, persistent), (KernelForm::Spirv, grid)] {
+        let open = || WgpuBackend::with_kernel_form(form)?.configured(config);
+        let Some(backend) = common::open_or_skip("the loop guard check", open) else {
             return;
         };
         let triangle = Triangle::new(Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
