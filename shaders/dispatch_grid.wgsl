@@ -8,9 +8,10 @@ override WORKGROUP_SIZE: u32 = 64u;
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x + gid.y * P.row_width;
-    if i >= item_count() {
+    let spread = item_spread();
+    if i >= item_count() * spread || i % spread != 0u {
         return;
     }
-    run_item(i);
+    run_item(i / spread);
     guard_loops();
 }

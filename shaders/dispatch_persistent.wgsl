@@ -16,7 +16,9 @@ var<workgroup> batch_start: u32;
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn main(@builtin(local_invocation_index) lane: u32) {
-    let n = item_count();
+    // Invocation slots: `item_spread` per item, of which the first takes it.
+    let spread = item_spread();
+    let n = item_count() * spread;
     for (var round = 0u; round < P.persistent_rounds; round = round + 1u) {
         if lane == 0u {
             batch_start = atomicAdd(&dispatch_state.next_item, WORKGROUP_SIZE);
@@ -28,8 +30,8 @@ fn main(@builtin(local_invocation_index) lane: u32) {
             break;
         }
         let i = start + lane;
-        if i < n {
-            run_item(i);
+        if i < n && i % spread == 0u {
+            run_item(i / spread);
         }
     }
     // After the fetch loop: a limiter that cut it short left items untraced.

@@ -34,3 +34,10 @@ fn guard_loops() {
         atomicMax(&dispatch_state.loops_cut, 1u);
     }
 }
+
+// Invocations per work item: 1, or `P.item_spread` when the host traces a batch again with one
+// item per SIMD group of invocations (lavapipe's groups are at most 16 wide), so that no group
+// runs the loops of several long items.
+fn item_spread() -> u32 {
+    return max(P.item_spread, 1u);
+}

@@ -64,6 +64,12 @@ struct Params {
     // and whether hits at one t count once (nonzero).
     all_hits_keep: u32,
     all_hits_merge: u32,
+    // Invocations per work item (0 and 1: one): a batch whose loops the device cut short is traced
+    // again with one item per SIMD group (loop_guard.wgsl, `item_of`).
+    item_spread: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;

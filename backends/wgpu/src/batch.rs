@@ -78,13 +78,31 @@ fn persistent_rounds(gpu: &Gpu) -> usize {
 /// The dispatch of `items` work items: workgroups in x and y, the grid's row width, and the rounds
 /// a persistent workgroup fetches at most (the workgroups cover the items within them).
 pub(crate) fn grid(gpu: &Gpu, launch: &Launch<'_>, items: usize) -> Result<Dispatched, Error> {
-    grid_in_rounds(gpu, launch, items, persistent_rounds(gpu))
+    spread_grid(gpu, launch, items, Spread::One)
 }
 
-/// [`grid`] with persistent workgroups that fetch at most `rounds` times.
-fn grid_in_rounds(gpu: &Gpu, launch: &Launch<'_>, items: usize, rounds: usize) -> Result<Dispatched, Error> {
+/// How many invocations a work item gets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Spread {
+    /// One: every invocation takes an item.
+    One,
+    /// [`SPREAD_ON_CUT`], in one round: a batch whose loops were cut, traced again.
+    OnePerGroup,
+}
+
+/// Invocations per item when a batch whose loops the device cut short is traced again: at least
+/// the widest SIMD group of llvmpipe (16 lanes of 32 bits with AVX-512), so that each group runs
+/// the loops of one item only.
+const SPREAD_ON_CUT: usize = 16;
+
+/// [`grid`] with `spread` invocations per item.
+fn spread_grid(gpu: &Gpu, launch: &Launch<'_>, items: usize, spread: Spread) -> Result<Dispatched, Error> {
     let wg = launch.config.workgroup_size as usize;
-    let rounds = rounds.max(1);
+    let (per_item, rounds) = match spread {
+        Spread::One => (1, persistent_rounds(gpu)),
+        Spread::OnePerGroup => (SPREAD_ON_CUT, 1),
+    };
+    let items = items.saturating_mul(per_item);
     // `launch` resolved the dispatch for its method (`Dispatch::for_method`): never `ByMethod` here.
     let groups = match launch.config.dispatch {
         Dispatch::Grid | Dispatch::ByMethod => items.div_ceil(wg),
@@ -99,7 +117,13 @@ fn grid_in_rounds(gpu: &Gpu, launch: &Launch<'_>, items: usize, rounds: usize) -
     if y > max_x {
         return Err(device_error(format!("{items} work items exceed one dispatch (batching failed)")));
     }
-    Ok(Dispatched { x: x as u32, y: y as u32, row_width: (x * wg) as u32, rounds: rounds as u32 })
+    Ok(Dispatched {
+        x: x as u32,
+        y: y as u32,
+        row_width: (x * wg) as u32,
+        rounds: rounds as u32,
+        spread: per_item as u32,
+    })
 }
 
 /// What [`grid`] decides.
@@ -108,12 +132,20 @@ pub(crate) struct Dispatched {
     pub y: u32,
     pub row_width: u32,
     pub rounds: u32,
+    /// Invocations per item.
+    pub spread: u32,
 }
 
 impl Dispatched {
     /// The batch's parameters: `base` with its ray count and the dispatch's figures.
     pub fn params(&self, base: Params, rays: usize) -> Params {
-        Params { ray_count: rays as u32, row_width: self.row_width, persistent_rounds: self.rounds, ..base }
+        Params {
+            ray_count: rays as u32,
+            row_width: self.row_width,
+            persistent_rounds: self.rounds,
+            item_spread: self.spread,
+            ..base
+        }
     }
 }
 
@@ -124,7 +156,8 @@ struct Pending {
     first: usize,
     rays: usize,
     submission: wgpu::SubmissionIndex,
-    /// One result per buffer mapped (hits, then records and timestamps where present).
+    /// One result per buffer mapped (hits, then records, timestamps and the dispatch state where
+    /// present).
     mapped: Vec<mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>>,
 }
 
@@ -163,8 +196,8 @@ pub(crate) enum Stamps<'q> {
     Around { queries: &'q wgpu::QuerySet, begin: bool, end: bool },
 }
 
-/// Records one batch's pass in `enc`: the kernel's scratch zeroed first (for persistent threads
-/// all of it, the item counter; else its first 16 bytes, the loop guard's flag), then the pass.
+/// Records one batch's pass in `enc`: the persistent item counter zeroed first, then the pass.
+/// The loop guard's flag is the caller's to zero, once for all the passes it reads it after.
 pub(crate) fn encode(
     gpu: &Gpu,
     enc: &mut wgpu::CommandEncoder,
@@ -173,11 +206,9 @@ pub(crate) fn encode(
     dims: (u32, u32),
     stamps: Stamps<'_>,
 ) {
-    let zeroed = match launch.config.dispatch {
-        Dispatch::Persistent { .. } => None,
-        Dispatch::Grid | Dispatch::ByMethod => Some(DISPATCH_STATE_BYTES),
-    };
-    enc.clear_buffer(&slot.scratch, 0, zeroed);
+    if let Dispatch::Persistent { .. } = launch.config.dispatch {
+        enc.clear_buffer(&slot.scratch, 0, Some(4));
+    }
     let bind = slot.bind_group(gpu, launch.bind_layout, launch.method, &launch.scene).clone();
     let timestamp_writes = match stamps {
         Stamps::Slot => slot.timer.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
@@ -256,22 +287,20 @@ pub(crate) fn run(
         }
         Ok(state[1] != 0)
     };
-    // `finish`, and a batch whose loops were cut traced again with one item per invocation: its
-    // persistent workgroups had fetched several (lavapipe's limit counts them all); if that is cut
-    // too, or it was one item each already, an error.
+    // `finish`, and a batch whose loops were cut traced again with one item per SIMD group of
+    // invocations (lavapipe's limit counts the loops of all the items a group runs: persistent
+    // rounds, and the neighbours of a long item); if that is cut too, an error. The kernel seconds
+    // then include both passes: the device spent them on this trace.
     let mut settle = |p: Pending, hits: &mut [Hit], records: &mut [u32], ws: &mut Workspace| -> Result<(), Error> {
         let (slot, first, n) = (p.slot, p.first, p.rays);
         if !finish(p, hits, records, ws)? {
             return Ok(());
         }
-        let several = matches!(launch.config.dispatch, Dispatch::Persistent { .. }) && persistent_rounds(gpu) > 1;
-        if several {
-            let again = submit(gpu, ws, launch, slot, &rays[first..first + n], first, 1)?;
-            if !finish(again, hits, records, ws)? {
-                return Ok(());
-            }
+        let again = submit(gpu, ws, launch, slot, &rays[first..first + n], first, Spread::OnePerGroup)?;
+        if finish(again, hits, records, ws)? {
+            return Err(loops_cut(n));
         }
-        Err(loops_cut(n))
+        Ok(())
     };
     gpu.checked("tracing a stream of batches", || -> Result<(), Error> {
         for (b, chunk) in rays.chunks(per_batch).enumerate() {
@@ -281,7 +310,7 @@ pub(crate) fn run(
                     settle(p, hits, &mut records, ws)?;
                 }
             }
-            pending.push_back(submit(gpu, ws, launch, slot_index, chunk, b * per_batch, persistent_rounds(gpu))?);
+            pending.push_back(submit(gpu, ws, launch, slot_index, chunk, b * per_batch, Spread::One)?);
         }
         while let Some(p) = pending.pop_front() {
             settle(p, hits, &mut records, ws)?;
@@ -292,8 +321,8 @@ pub(crate) fn run(
 }
 
 /// Uploads `chunk` (the stream's rays from `first` on) to slot `slot_index`, dispatches it with
-/// persistent workgroups fetching at most `rounds` times, and starts reading back its hits,
-/// records, timestamps and dispatch state.
+/// `spread` invocations per item, and starts reading back its hits, records, timestamps and
+/// dispatch state.
 fn submit(
     gpu: &Gpu,
     ws: &mut Workspace,
@@ -301,13 +330,13 @@ fn submit(
     slot_index: usize,
     chunk: &[Ray],
     first: usize,
-    rounds: usize,
+    spread: Spread,
 ) -> Result<Pending, Error> {
     let stride = launch.params.record_stride as usize;
     let max_bytes = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
     let n = chunk.len();
     let items = n.div_ceil(launch.rays_per_item);
-    let d = grid_in_rounds(gpu, launch, items, rounds)?;
+    let d = spread_grid(gpu, launch, items, spread)?;
     let params = d.params(launch.params, n);
     let need = SlotNeeds { rays: n, record_words: n * stride, scratch_bytes: launch.scratch_bytes(n) };
     let slot = ws.slot(gpu, slot_index, need, max_bytes);
@@ -318,10 +347,11 @@ fn submit(
         rounds_of_streams(gpu, launch, slot, params, (d.x, d.y))?;
     }
     let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
-    // The kernels of the dispatch files carry the loop guard; the stream kernel's rounds read the
-    // scratch themselves.
+    // The kernels of the dispatch files and the wide packet kernel carry the loop guard; the
+    // stream kernel's rounds read the scratch themselves.
     let guarded = launch.scratch_per_item == 0;
     if guarded {
+        enc.clear_buffer(&slot.scratch, 0, Some(DISPATCH_STATE_BYTES));
         encode(gpu, &mut enc, launch, slot, (d.x, d.y), Stamps::Slot);
         enc.copy_buffer_to_buffer(&slot.scratch, 0, &slot.scratch_back, 0, DISPATCH_STATE_BYTES);
     }
@@ -358,9 +388,9 @@ fn submit(
 pub(crate) const DISPATCH_STATE_BYTES: u64 = 16;
 
 /// The error for a batch of `rays` rays whose loops the device cut short, even with one item per
-/// invocation. Mesa's llvmpipe ends a SIMD group's loops once they have run 65,535 iterations in
-/// all and says nothing; the walks it cut report misses, so the batch's hits are refused rather
-/// than returned.
+/// SIMD group of invocations. Mesa's llvmpipe ends a SIMD group's loops once they have run 65,535 iterations in
+/// all and says nothing; the walks it cut report misses, so the trace fails rather than succeed
+/// with them (what the hits buffer holds after the error is not an answer, as after any error).
 pub(crate) fn loops_cut(rays: usize) -> Error {
     device_error(format!(
         "the device cut the kernel's loops short in a batch of {rays} rays (Mesa's llvmpipe ends a \

@@ -88,7 +88,7 @@ pub const MAX_PERSISTENT_ROUNDS: usize = 4096;
 /// shader counting against the one limit: unbounded, the first workgroup took nearly every item
 /// and stopped in the middle of one, leaving hits unwritten (seen on the conformance suite's
 /// adversarial rays with kd-packet). Two rounds still run the fetch loop; a batch whose loops the
-/// guard finds cut short is traced again in one round (shaders/loop_guard.wgsl).
+/// guard finds cut short is traced again with one item per SIMD group (shaders/loop_guard.wgsl).
 pub const CPU_ADAPTER_ROUNDS: usize = 2;
 
 /// The stream kernel's steps per round on a CPU adapter (shaders/wide_ray_stream.wgsl): a step's

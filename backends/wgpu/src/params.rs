@@ -2,7 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Per-batch and per-scene constants, laid out as the WGSL struct (112 bytes).
+/// Per-batch and per-scene constants, laid out as the WGSL struct (128 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub(crate) struct Params {
@@ -34,12 +34,16 @@ pub(crate) struct Params {
     /// at one `t` count once (1) or not (0).
     pub all_hits_keep: u32,
     pub all_hits_merge: u32,
+    /// Invocations per work item (0 and 1: one; see [`crate::batch`]'s retry of a batch whose
+    /// loops were cut): only every `item_spread`-th invocation takes an item.
+    pub item_spread: u32,
+    pub pad: [u32; 3],
 }
 
 #[cfg(test)]
 mod tests {
     #[test]
     fn params_match_the_wgsl_size() {
-        assert_eq!(core::mem::size_of::<super::Params>(), 112);
+        assert_eq!(core::mem::size_of::<super::Params>(), 128);
     }
 }

@@ -65,8 +65,9 @@ fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntr
 impl Pipelines {
     pub fn new(gpu: &Gpu) -> Pipelines {
         // shaders/prelude.wgsl: parameters, rays (read), hits (write), three scene buffers (read),
-        // records (write); the kernel scratch (read and write): shaders/dispatch_persistent.wgsl's
-        // item counter, shaders/wide_ray_stream.wgsl's lists.
+        // records (write); the kernel scratch (read and write): shaders/loop_guard.wgsl's dispatch
+        // state (the persistent item counter, the loop guard's flag), shaders/wide_ray_stream.wgsl's
+        // lists.
         let (read, write) = (Some(true), Some(false));
         let (bind_layout, layout) =
             buffer_layout(gpu, "raytrail", &[None, read, write, read, read, read, write, write]);

@@ -187,7 +187,10 @@ fn upload(gpu: &Gpu, ws: &mut Workspace, launch: &Launch<'_>, rays: &[Ray]) -> R
         let params = d.params(launch.params, n);
         let need = SlotNeeds { rays: n, record_words: 0, scratch_bytes: launch.scratch_bytes(n) };
         let slot = ws.slot(gpu, b, need, max_bytes);
+        slot.unmap_leftovers();
         gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&params));
+        // The loop guard's flag, zeroed once: any timed pass that raises it is seen.
+        gpu.queue.write_buffer(&slot.scratch, 0, &[0u8; batch::DISPATCH_STATE_BYTES as usize]);
         gpu.queue.write_buffer(&slot.rays, 0, bytemuck::cast_slice(chunk));
         batches.push((b, (d.x, d.y), n));
     }
@@ -226,8 +229,9 @@ fn passes(
     });
     enc.resolve_query_set(queries, 0..2, &resolve, 0);
     enc.copy_buffer_to_buffer(&resolve, 0, &back, 0, 16);
-    // Each batch's last pass left its loop guard's flag (shaders/loop_guard.wgsl) in its scratch:
-    // a time is not reported for walks the device cut short.
+    // The loop guard's flag (shaders/loop_guard.wgsl), zeroed at the upload and raised by any pass
+    // of the batch whose loops were cut: a time is not reported for walks the device cut short
+    // (unlike a trace, timing does not trace such a batch again in smaller shares).
     for &(slot_index, _, _) in &up.batches {
         let slot = ws.slot(gpu, slot_index, SlotNeeds::default(), max_bytes);
         enc.copy_buffer_to_buffer(&slot.scratch, 0, &slot.scratch_back, 0, batch::DISPATCH_STATE_BYTES);
