@@ -3,8 +3,8 @@
 // shader against one limit of 65,535, and past it ends each loop after its current iteration
 // without a word: a walk stops halfway and its ray reports a miss. A loop that must run twice then
 // runs once, so each kernel runs such a loop when all its work is done and raises `loops_cut`,
-// which the host reads back with the hits: it traces the batch again in smaller shares, or fails
-// the trace, rather than return them.
+// which the host reads back with the hits: it traces the batch again with one item per SIMD group,
+// or fails the trace, rather than return them.
 
 struct DispatchState {
     // dispatch_persistent.wgsl's item counter.

@@ -65,7 +65,7 @@ struct Params {
     all_hits_keep: u32,
     all_hits_merge: u32,
     // Invocations per work item (0 and 1: one): a batch whose loops the device cut short is traced
-    // again with one item per SIMD group (loop_guard.wgsl, `item_of`).
+    // again with one item per SIMD group (loop_guard.wgsl, `item_spread`).
     item_spread: u32,
     pad0: u32,
     pad1: u32,

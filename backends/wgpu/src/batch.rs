@@ -8,7 +8,7 @@ use crate::device::{device_error, Gpu};
 use crate::params::Params;
 use crate::workspace::{SceneBindings, Slot, SlotNeeds, Workspace, HIT_BYTES};
 use bytemuck::Pod;
-use raytrail_core::method::Method;
+use raytrail_core::method::{Method, WideWalk};
 use raytrail_core::{Error, Hit, Ray};
 use std::collections::VecDeque;
 use std::sync::mpsc;
@@ -290,11 +290,16 @@ pub(crate) fn run(
     // `finish`, and a batch whose loops were cut traced again with one item per SIMD group of
     // invocations (lavapipe's limit counts the loops of all the items a group runs: persistent
     // rounds, and the neighbours of a long item); if that is cut too, an error. The kernel seconds
-    // then include both passes: the device spent them on this trace.
+    // then include both passes: the device spent them on this trace. The wide packet kernel's item
+    // is a whole workgroup, which no spread divides: a cut there is an error at once.
+    let spreads = !launch.method.wide().is_some_and(|m| m.walk() == WideWalk::Packet);
     let mut settle = |p: Pending, hits: &mut [Hit], records: &mut [u32], ws: &mut Workspace| -> Result<(), Error> {
         let (slot, first, n) = (p.slot, p.first, p.rays);
         if !finish(p, hits, records, ws)? {
             return Ok(());
+        }
+        if !spreads {
+            return Err(loops_cut(n));
         }
         let again = submit(gpu, ws, launch, slot, &rays[first..first + n], first, Spread::OnePerGroup)?;
         if finish(again, hits, records, ws)? {
@@ -388,9 +393,10 @@ fn submit(
 pub(crate) const DISPATCH_STATE_BYTES: u64 = 16;
 
 /// The error for a batch of `rays` rays whose loops the device cut short, even with one item per
-/// SIMD group of invocations. Mesa's llvmpipe ends a SIMD group's loops once they have run 65,535 iterations in
-/// all and says nothing; the walks it cut report misses, so the trace fails rather than succeed
-/// with them (what the hits buffer holds after the error is not an answer, as after any error).
+/// SIMD group of invocations. Mesa's llvmpipe ends a SIMD group's loops once they have run 65,535
+/// iterations in all and says nothing; the walks it cut report misses, so the trace fails rather
+/// than succeed with them (what the hits buffer holds after the error is not an answer, as after
+/// any error).
 pub(crate) fn loops_cut(rays: usize) -> Error {
     device_error(format!(
         "the device cut the kernel's loops short in a batch of {rays} rays (Mesa's llvmpipe ends a \

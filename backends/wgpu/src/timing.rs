@@ -231,7 +231,7 @@ fn passes(
     enc.copy_buffer_to_buffer(&resolve, 0, &back, 0, 16);
     // The loop guard's flag (shaders/loop_guard.wgsl), zeroed at the upload and raised by any pass
     // of the batch whose loops were cut: a time is not reported for walks the device cut short
-    // (unlike a trace, timing does not trace such a batch again in smaller shares).
+    // (unlike a trace, timing does not trace such a batch again with one item per SIMD group).
     for &(slot_index, _, _) in &up.batches {
         let slot = ws.slot(gpu, slot_index, SlotNeeds::default(), max_bytes);
         enc.copy_buffer_to_buffer(&slot.scratch, 0, &slot.scratch_back, 0, batch::DISPATCH_STATE_BYTES);

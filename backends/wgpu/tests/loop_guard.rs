@@ -1,6 +1,6 @@
 //! The loop guard (shaders/loop_guard.wgsl): a device that cuts a kernel's loops short must make
-//! the trace fail with an error that says so, or trace the batch again in smaller shares, and never
-//! return the misses of walks it stopped.
+//! the trace fail with an error that says so, or trace the batch again one item per SIMD group,
+//! and never return the misses of walks it stopped.
 //!
 //! The scenes are copies of one triangle, which no kd-tree split separates: one leaf holds them
 //! all, and a ray through it tests every one in a single loop. Mesa's llvmpipe (lavapipe) counts
@@ -112,7 +112,7 @@ fn a_batch_cut_short_is_traced_again_one_item_per_simd_group() {
     let options = TraceOptions::new(Method::Kd(KdMethod::Packet));
     let (scene, rays, expected) = stack_of_copies(&backend, 6_000, options.method, 256);
     let mut hits = vec![Hit::MISS; rays.len()];
-    backend.trace(&scene, &rays, &options, &mut hits).expect("the batch traced again in smaller shares");
+    backend.trace(&scene, &rays, &options, &mut hits).expect("the batch traced again one item per SIMD group");
     for (got, want) in hits.iter().zip(&expected) {
         assert!(got.same_as(want), "{got:?}, serial {want:?}");
     }
