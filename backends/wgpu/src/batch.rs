@@ -285,7 +285,7 @@ pub(crate) fn run(
             take(&slot.scratch_back, &mut state)?;
             slot.mapped &= !8;
         }
-        Ok(state[1] != 0)
+        Ok(loops_were_cut(&state))
     };
     // `finish`, and a batch whose loops were cut traced again with one item per SIMD group of
     // invocations (lavapipe's limit counts the loops of all the items a group runs: persistent
@@ -356,7 +356,12 @@ fn submit(
     // stream kernel's rounds read the scratch themselves.
     let guarded = launch.scratch_per_item == 0;
     if guarded {
-        enc.clear_buffer(&slot.scratch, 0, Some(DISPATCH_STATE_BYTES));
+        // The flag and the words after it; `encode` zeroes the persistent item counter before it.
+        enc.clear_buffer(
+            &slot.scratch,
+            LOOPS_CUT_WORD as u64 * 4,
+            Some(DISPATCH_STATE_BYTES - LOOPS_CUT_WORD as u64 * 4),
+        );
         encode(gpu, &mut enc, launch, slot, (d.x, d.y), Stamps::Slot);
         enc.copy_buffer_to_buffer(&slot.scratch, 0, &slot.scratch_back, 0, DISPATCH_STATE_BYTES);
     }
@@ -391,6 +396,15 @@ fn submit(
 /// Bytes of the dispatch state at the start of the kernel's scratch (shaders/loop_guard.wgsl's
 /// `DispatchState`: the persistent item counter, then the loop guard's flag), rounded to 16.
 pub(crate) const DISPATCH_STATE_BYTES: u64 = 16;
+
+/// The word of the dispatch state that holds the loop guard's flag (`DispatchState::loops_cut`).
+const LOOPS_CUT_WORD: usize = 1;
+
+/// Whether the dispatch state read back from a pass (its first words) has the loop guard's flag
+/// raised.
+pub(crate) fn loops_were_cut(state: &[u32]) -> bool {
+    state.get(LOOPS_CUT_WORD).is_some_and(|&flag| flag != 0)
+}
 
 /// The error for a batch of `rays` rays whose loops the device cut short, even with one item per
 /// SIMD group of invocations. Mesa's llvmpipe ends a SIMD group's loops once they have run 65,535

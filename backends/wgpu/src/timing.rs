@@ -241,7 +241,7 @@ fn passes(
     for &(slot_index, _, rays) in &up.batches {
         let slot = ws.slot(gpu, slot_index, SlotNeeds::default(), max_bytes);
         let state = batch::read::<u32>(gpu, &slot.scratch_back, 4)?;
-        if state[1] != 0 {
+        if batch::loops_were_cut(&state) {
             return Err(batch::loops_cut(rays));
         }
     }
