@@ -8,7 +8,9 @@
 #   scripts/ab-cpu.sh OLD_REV SCENE [VIEW=inside] [METHOD=bvh8] [ROUNDS=15] [SETS=primary,shadow,diffuse,ao]
 #
 # Environment: AB_SIZE=WxH (primary rays, default 384x288); AB_TILES=1 orders the camera rays in
-# tiles of 8 x 8 pixels; AB_NEW_METHOD=NAME makes the new side trace with another method (say
+# tiles of 8 x 8 pixels; AB_SHUFFLE=1 shuffles the shadow, diffuse and AO rays by a fixed seed;
+# AB_SORTED=1 has both sides trace every set sorted (TraceOrder::Sorted; the old commit must have
+# it); AB_NEW_METHOD=NAME makes the new side trace with another method (say
 # bvh8-packet against the old side's bvh8); AB_TRAV, AB_MAXLEAF, AB_BLOCK, AB_BINS change the new
 # side's SAH settings (to try a builder change without editing it); AB_FRESH=0 keeps one copy of each tree for all
 # rounds (by default each round traces fresh copies, so that where the trees land in physical
@@ -19,7 +21,7 @@
 # into one binary.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 2 ] || { sed -n 2,19p "$0"; exit 2; }
+[ $# -ge 2 ] || { sed -n 2,21p "$0"; exit 2; }
 rev=$1; shift
 old=$(mktemp -d /tmp/raytrail-ab-old.XXXXXX)
 trap 'git -C "$root" worktree remove --force "$old" >/dev/null 2>&1 || true' EXIT

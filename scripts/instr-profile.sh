@@ -9,12 +9,13 @@
 #
 #   scripts/instr-profile.sh SCENE [VIEW=inside] [METHOD=bvh8] [SET=shadow] [TIMES=4]
 #
-# Environment: AB_SIZE=WxH (camera rays, default 384x288), MCA_CPU (llvm-mca's -mcpu, default
-# znver3). The rays and the tree are scripts/ab-cpu.sh's (same harness, one thread; the tree is
-# the SAH builder's). Under callgrind a trace runs about 50 times slower than natively.
+# Environment: AB_SIZE=WxH (camera rays, default 384x288), AB_SHUFFLE=1 and AB_SORTED=1 (as
+# scripts/ab-cpu.sh takes them), MCA_CPU (llvm-mca's -mcpu, default znver3). The rays and the
+# tree are scripts/ab-cpu.sh's (same harness, one thread; the tree is the SAH builder's). Under
+# callgrind a trace runs about 50 times slower than natively.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 1 ] || { sed -n 2,15p "$0"; exit 2; }
+[ $# -ge 1 ] || { sed -n 2,16p "$0"; exit 2; }
 command -v valgrind >/dev/null || { echo "instr-profile: needs valgrind (apt-get install valgrind)" >&2; exit 2; }
 scene=$1 view=${2:-inside} method=${3:-bvh8} set=${4:-shadow} times=${5:-4}
 out=$(mktemp /tmp/raytrail-callgrind.XXXXXX)

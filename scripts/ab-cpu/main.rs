@@ -118,7 +118,14 @@ fn main() {
     let sh = conf::rays::shadow(&prim, &hits, conf::rays::default_light(bounds), conf::rays::scene_epsilon(bounds));
     let radius = 0.05 * bounds.extent().length();
     let ao: Vec<rc::Ray> = diff.iter().map(|r| rc::Ray::new(r.origin(), r.dir(), r.tmin, radius)).collect();
-    let all = [("primary", prim, false), ("shadow", sh, true), ("diffuse", diff, false), ("ao", ao, true)];
+    let mut all = [("primary", prim, false), ("shadow", sh, true), ("diffuse", diff, false), ("ao", ao, true)];
+    // AB_SHUFFLE=1: the shadow, diffuse and AO rays shuffled by a fixed seed, as the bench's
+    // `--order shuffled` and a path tracer's later bounces come.
+    if std::env::var("AB_SHUFFLE").is_ok_and(|v| v == "1") {
+        for (k, set) in all.iter_mut().enumerate().skip(1) {
+            conf::rng::Pcg32::new(conf::rays::RAY_SEED, k as u64).shuffle(&mut set.1);
+        }
+    }
     for (name, rays, any) in all.iter() {
         if !sets_wanted.iter().any(|s| s == name) {
             continue;
@@ -127,8 +134,14 @@ fn main() {
             rays.iter().map(|r| oc::Ray { origin: r.origin, tmin: r.tmin, dir: r.dir, tmax: r.tmax }).collect();
         let q = if *any { rc::method::Query::Any } else { rc::method::Query::Closest };
         let oq = if *any { oc::method::Query::Any } else { oc::method::Query::Closest };
-        let nopts = rc::trace::TraceOptions::new(m).query(q);
-        let oopts = oc::trace::TraceOptions::new(om).query(oq);
+        let (mut nopts, mut oopts) =
+            (rc::trace::TraceOptions::new(m).query(q), oc::trace::TraceOptions::new(om).query(oq));
+        // AB_SORTED=1: both sides trace the batch sorted (`TraceOrder::Sorted`, the sort inside
+        // the timed and counted call; the old commit must have it).
+        if std::env::var("AB_SORTED").is_ok_and(|v| v == "1") {
+            nopts = nopts.order(rc::trace_order::TraceOrder::Sorted);
+            oopts = oopts.order(oc::trace_order::TraceOrder::Sorted);
+        }
         let mut nh = vec![rc::Hit::MISS; rays.len()];
         let mut oh = vec![oc::Hit::MISS; rays.len()];
         if let Some(times) = std::env::var("AB_COUNT").ok().and_then(|v| v.parse::<usize>().ok()) {
