@@ -13,7 +13,8 @@
 //! enough for that to be cheap; on a smaller batch that still fills [`MIN_STREAMS_PER_THREAD`]
 //! streams on every thread, it is taken by rule where the winner walks single rays (the sample
 //! found no coherence that packets profit from), as it was the faster on every such batch of the
-//! notes' table.
+//! notes' table. A closest-hit batch smaller still, of at least [`SMALL_CHECK_MIN_STREAMS_PER_THREAD`]
+//! streams a thread, won by single rays, has the two timed on one whole stream a thread.
 
 use raytrail_core::method::{Method, Query, WideMethod, WideWalk};
 use raytrail_core::trace::{Trace, TraceOptions};
@@ -32,6 +33,17 @@ pub const CHECK_SHARE: usize = 16;
 
 /// Streams per thread a batch too small for the check must fill for the rule to take a list walk.
 pub const MIN_STREAMS_PER_THREAD: usize = 16;
+
+/// Streams per thread a closest-hit batch too small for the check and the rule must fill for the
+/// small check: the sample's single-ray winner and the list walk timed on one whole stream a
+/// thread (its three traces cost up to three eighths of one trace of such a batch). On batches of
+/// 8-16 streams a thread whose sample single rays won, the list walk was the faster on the full
+/// dragon's diffuse rays (1.15-1.23 from outside, 69,003 rays on two threads; 1.17-1.21 from
+/// inside, 82,944) and the kitchen's from inside (1.07-1.09), tied on Sponza's from inside
+/// (0.95-1.03) and lost on Sponza's from outside (0.89-0.91, 116,601), so it is timed there, not
+/// taken by rule (`docs/notes/*-walk-experiments-and-auto-lists.md`). Any-hit batches are left
+/// out: there the list walk lost on the kitchen's shuffled shadow rays from inside (0.86-0.88).
+pub const SMALL_CHECK_MIN_STREAMS_PER_THREAD: usize = 8;
 
 /// Why a list walk was taken instead of the sample's winner, or was not.
 #[derive(Clone, Debug, PartialEq)]
@@ -140,24 +152,23 @@ pub fn whole_streams(rays: &[Ray], count: usize) -> Vec<Ray> {
     out
 }
 
-/// Times `winner` and `lists` on whole streams of `rays` traced with `query`: one untimed trace
-/// of the list walk (without it, its first trace on the check's few streams ran a quarter slower
-/// than over the batch, and the check called a tie where the batch had the list walk 1.3 times
-/// ahead), then one timed trace of each. `None` where the batch holds fewer than [`CHECK_SHARE`]
-/// times the check's rays.
+/// Times `winner` and `lists` on `per_thread` whole streams a thread of `rays` traced with
+/// `query`: one untimed trace of the list walk (without it, its first trace on the check's few
+/// streams ran a quarter slower than over the batch, and the check called a tie where the batch
+/// had the list walk 1.3 times ahead), then one timed trace of each. `None` where the batch holds
+/// fewer streams than that.
 pub fn check(
     backend: &CpuBackend,
     scene: &CpuScene,
     rays: &[Ray],
     query: Query,
-    winner: Method,
-    lists: Method,
+    (winner, lists): (Method, Method),
+    per_thread: usize,
 ) -> Result<Option<StreamCheck>, Error> {
-    let count = CHECK_STREAMS_PER_THREAD * backend.threads().max(1);
-    if rays.len() < CHECK_SHARE * count * STREAM_RAYS {
+    let sample = whole_streams(rays, per_thread * backend.threads().max(1));
+    if sample.is_empty() {
         return Ok(None);
     }
-    let sample = whole_streams(rays, count);
     let mut hits = vec![Hit::MISS; sample.len()];
     let mut time = |m: Method| -> Result<f64, Error> {
         Ok(backend.trace(scene, &sample, &TraceOptions::new(m).query(query), &mut hits)?.seconds)
@@ -196,11 +207,28 @@ pub fn judge(
     let Some(lists) = lists_of(winner).filter(|l| candidates.contains(l) && !walks_lists(winner)) else {
         return Ok(None);
     };
-    if let Some(c) = check(backend, scene, rays, query, winner, lists)? {
-        return Ok(Some(ListsVerdict::Timed(c)));
+    let threads = backend.threads().max(1);
+    if rays.len() >= CHECK_SHARE * CHECK_STREAMS_PER_THREAD * threads * STREAM_RAYS {
+        return Ok(
+            check(backend, scene, rays, query, (winner, lists), CHECK_STREAMS_PER_THREAD)?.map(ListsVerdict::Timed)
+        );
     }
-    Ok(lists_instead(winner, rays.len(), backend.threads(), candidates)
-        .map(|lists| ListsVerdict::Rule { winner, lists }))
+    if let Some(lists) = lists_instead(winner, rays.len(), threads, candidates) {
+        return Ok(Some(ListsVerdict::Rule { winner, lists }));
+    }
+    if small_check(winner, rays.len(), query, threads) {
+        return Ok(check(backend, scene, rays, query, (winner, lists), 1)?.map(ListsVerdict::Timed));
+    }
+    Ok(None)
+}
+
+/// Whether a batch of `rays` answering `query` on `threads` threads, too small for the check and
+/// the rule, has `winner` timed against the list walk on one stream a thread: a closest-hit batch
+/// of at least [`SMALL_CHECK_MIN_STREAMS_PER_THREAD`] streams a thread whose sample single rays
+/// won.
+pub fn small_check(winner: Method, rays: usize, query: Query, threads: usize) -> bool {
+    let single = winner.wide().is_some_and(|m| m.walk() == WideWalk::Stack);
+    single && query == Query::Closest && rays >= SMALL_CHECK_MIN_STREAMS_PER_THREAD * threads.max(1) * STREAM_RAYS
 }
 
 #[cfg(test)]
@@ -256,6 +284,16 @@ mod tests {
         assert_eq!(c(1.0, 0.99), LISTS);
         assert_eq!(c(1.0, 1.0), SINGLE, "a tie keeps the sample's winner");
         assert_eq!(c(1.0, 1.2), SINGLE);
+    }
+
+    #[test]
+    fn the_small_check_is_for_closest_hit_batches_won_by_single_rays() {
+        let eight = SMALL_CHECK_MIN_STREAMS_PER_THREAD * 2 * STREAM_RAYS;
+        assert!(small_check(SINGLE, eight, Query::Closest, 2));
+        assert!(!small_check(SINGLE, eight - 1, Query::Closest, 2), "too few streams per thread");
+        assert!(!small_check(SINGLE, eight, Query::Closest, 3), "the same batch on more threads");
+        assert!(!small_check(SINGLE, eight, Query::Any, 2), "any-hit rays");
+        assert!(!small_check(Method::Wide(WideMethod::BVH8_SAH_PACKET), eight, Query::Closest, 2), "packets won");
     }
 
     #[test]
