@@ -5,10 +5,12 @@
 //! Laine 2017) and keeps nothing else: every walk it picks from reads that one tree. For a large
 //! batch it chooses among the three walks as `--method auto` does (single rays and packets timed
 //! on a sample of the rays, the ray lists on whole streams of the batch: `analysis::streams`),
-//! and traces the batch with the fastest; a small batch goes ray by ray (what suits rays in no
-//! useful order). A method named with [`TracerBuilder::method`] is used for every batch instead, and the
+//! and traces the batch with the fastest, keeping the choice for the next calls with a batch of
+//! that kind (`analysis::plans`); a small batch goes ray by ray (what suits rays in no useful
+//! order). A method named with [`TracerBuilder::method`] is used for every batch instead, and the
 //! scene is prepared for it alone.
 
+use crate::analysis::plans::{BatchKind, Plans};
 use crate::analysis::sample::choose_among;
 use crate::{Builder, Error, InstancedTracer};
 use raytrail_core::all_hits::{AllHits, AllHitsOptions};
@@ -22,7 +24,7 @@ use raytrail_core::trace_order::TraceOrder;
 use raytrail_core::{Hit, Ray};
 use raytrail_cpu::{CpuBackend, CpuScene};
 use std::cell::RefCell;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, PoisonError};
 
 /// The walks of the 8-wide tree of least node area that the default tracer picks from: single
 /// rays (incoherent rays, small batches), packets (camera rays, shadow rays toward one light),
@@ -114,7 +116,13 @@ impl TracerBuilder {
             None => &AUTO_WALKS,
         };
         let prepared = backend.prepare(Arc::new(PreparedScene::new(scene, bvh, methods)?))?;
-        Ok(Tracer { backend, scene: prepared, method: self.method, reject_untraceable: self.reject_untraceable })
+        Ok(Tracer {
+            backend,
+            scene: prepared,
+            method: self.method,
+            reject_untraceable: self.reject_untraceable,
+            plans: Mutex::default(),
+        })
     }
 }
 
@@ -140,6 +148,9 @@ pub struct Tracer {
     scene: CpuScene,
     method: Option<Method>,
     reject_untraceable: bool,
+    /// `auto`'s choices by kind of batch, each reused for a number of calls
+    /// ([`crate::analysis::plans`]).
+    plans: Mutex<Plans<(Method, TraceOrder)>>,
 }
 
 thread_local! {
@@ -319,13 +330,17 @@ impl Tracer {
     pub fn refit_scene(&mut self, scene: &Scene) -> Result<(), Error> {
         // A prepared scene the caller still holds ([`Tracer::prepared`]) is copied, not changed.
         self.backend.refit(Arc::make_mut(&mut self.scene.0), scene)?;
+        // The choices were made on the old tree.
+        self.plans.get_mut().unwrap_or_else(PoisonError::into_inner).clear();
         Ok(())
     }
 
     /// The method this tracer would trace `rays` with for `query`: the one it was built for, or
     /// for a batch of at least [`AUTO_MIN_RAYS`] rays, the walk for sorted rays where it sorts the
     /// batch ([`crate::analysis::order::sorted_walk`]: large, in no useful order, slow per ray)
-    /// and otherwise the fastest of [`AUTO_WALKS`] on a sample.
+    /// and otherwise the fastest of [`AUTO_WALKS`] on a sample. The choice for a kind of batch
+    /// (query, size to a power of two, order) is kept and serves the next
+    /// [`REUSES`](crate::analysis::plans::REUSES) calls of that kind before it is made again.
     pub fn method_for(&self, rays: &[Ray], query: Query) -> Result<Method, Error> {
         Ok(self.plan_for(rays, query)?.0)
     }
@@ -335,13 +350,21 @@ impl Tracer {
         Ok(match self.method {
             Some(m) => (m, TraceOrder::AsGiven),
             None if rays.len() >= AUTO_MIN_RAYS => {
-                match crate::analysis::order::sorted_walk(&self.backend, &self.scene, rays, query)?.0 {
+                let kind = BatchKind::of(rays, query);
+                let kept = self.plans.lock().unwrap_or_else(PoisonError::into_inner).reuse(kind);
+                if let Some(plan) = kept {
+                    return Ok(plan);
+                }
+                // Chosen without the lock held: another thread's call of another kind need not wait.
+                let plan = match crate::analysis::order::sorted_walk(&self.backend, &self.scene, rays, query)?.0 {
                     Some(m) => (m, TraceOrder::Sorted),
                     None => (
                         choose_among(&AUTO_WALKS, &self.backend, &self.scene, rays, query)?.method,
                         TraceOrder::AsGiven,
                     ),
-                }
+                };
+                self.plans.lock().unwrap_or_else(PoisonError::into_inner).keep(kind, plan);
+                plan
             }
             None => (AUTO_WALKS[0], TraceOrder::AsGiven),
         })

@@ -3,6 +3,7 @@
 //!
 //! - [`choice`]: picking a method per kind of ray from timings of a sample (`--method auto`);
 //! - [`sample`]: the sample and the CPU backend's clock;
+//! - [`plans`]: the choices a [`Tracer`](crate::Tracer) keeps per kind of batch;
 //! - [`needs`]: whether 64-bit keys, hash tables, the `f64` fallback, the disjoint mask and the
 //!   slack are needed;
 //! - `shaders` (feature `gpu`): the wgpu kernels the choices compile.
@@ -13,6 +14,7 @@
 pub mod choice;
 pub mod needs;
 pub mod order;
+pub mod plans;
 pub mod sample;
 #[cfg(feature = "gpu")]
 pub mod shaders;
