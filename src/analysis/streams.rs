@@ -128,6 +128,17 @@ pub fn walks_lists(method: Method) -> bool {
     method.wide().is_some_and(|m| m.walk() == WideWalk::RayLists)
 }
 
+/// Whether `method` walks single rays down a wide tree (the sample's winner the rule and the
+/// small check give way to the list walk).
+pub fn walks_single_rays(method: Method) -> bool {
+    method.wide().is_some_and(|m| m.walk() == WideWalk::Stack)
+}
+
+/// Whether a batch of `rays` fills `streams` whole streams on each of `threads` threads.
+fn fills(rays: usize, streams: usize, threads: usize) -> bool {
+    rays >= streams * threads.max(1) * STREAM_RAYS
+}
+
 /// The ray-list walk of `method`'s wide tree (`None` for a method of no wide tree, or of a tree
 /// no list walk reads).
 pub fn lists_of(method: Method) -> Option<Method> {
@@ -189,9 +200,8 @@ pub fn check(
 /// traced on `threads` threads: that of its tree, where `winner` walks single rays, the batch
 /// fills [`MIN_STREAMS_PER_THREAD`] streams per thread and the walk is among `candidates`.
 pub fn lists_instead(winner: Method, rays: usize, threads: usize, candidates: &[Method]) -> Option<Method> {
-    let single = winner.wide().is_some_and(|m| m.walk() == WideWalk::Stack);
-    let fills = rays >= MIN_STREAMS_PER_THREAD * threads.max(1) * STREAM_RAYS;
-    lists_of(winner).filter(|l| single && fills && candidates.contains(l))
+    let taken = walks_single_rays(winner) && fills(rays, MIN_STREAMS_PER_THREAD, threads);
+    lists_of(winner).filter(|l| taken && candidates.contains(l))
 }
 
 /// The verdict on the list walk of `winner`'s tree for `rays` (`None`: no list walk is a
@@ -208,7 +218,7 @@ pub fn judge(
         return Ok(None);
     };
     let threads = backend.threads().max(1);
-    if rays.len() >= CHECK_SHARE * CHECK_STREAMS_PER_THREAD * threads * STREAM_RAYS {
+    if fills(rays.len(), CHECK_SHARE * CHECK_STREAMS_PER_THREAD, threads) {
         return Ok(
             check(backend, scene, rays, query, (winner, lists), CHECK_STREAMS_PER_THREAD)?.map(ListsVerdict::Timed)
         );
@@ -227,8 +237,7 @@ pub fn judge(
 /// of at least [`SMALL_CHECK_MIN_STREAMS_PER_THREAD`] streams a thread whose sample single rays
 /// won.
 pub fn small_check(winner: Method, rays: usize, query: Query, threads: usize) -> bool {
-    let single = winner.wide().is_some_and(|m| m.walk() == WideWalk::Stack);
-    single && query == Query::Closest && rays >= SMALL_CHECK_MIN_STREAMS_PER_THREAD * threads.max(1) * STREAM_RAYS
+    walks_single_rays(winner) && query == Query::Closest && fills(rays, SMALL_CHECK_MIN_STREAMS_PER_THREAD, threads)
 }
 
 #[cfg(test)]
